@@ -1,0 +1,162 @@
+#pragma once
+/// The scene: what the user describes in a TOML file (reference: docs/scene.md). Every string
+/// is parsed into an enum or a typed SI value here, once; nothing past the parser sees text.
+#include <array>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "mpm/types.hpp"
+
+namespace mpm {
+
+/// Where a value came from, for error messages ("scene.toml:12", or "--set solver.cfl").
+struct SourceLoc {
+  std::string file;
+  int line = 0;
+  std::string key;  ///< dotted path, e.g. "materials.copper.density"
+};
+
+enum class StrengthModel { Elastic, J2, JohnsonCook };
+enum class EosModel { Linear, MieGruneisen };
+
+/// Deviatoric strength. J2: sigma_y = A + B eps_p^n. Johnson-Cook multiplies by
+/// (1 + C ln(rate/rate0)) (1 - T*^m), T* = (T - T_room)/(T_melt - T_room).
+struct StrengthSpec {
+  StrengthModel model = StrengthModel::Elastic;
+  double A = 0;                     ///< initial yield stress, Pa
+  double B = 0;                     ///< hardening modulus, Pa
+  double n = 1;                     ///< hardening exponent
+  double C = 0;                     ///< strain-rate coefficient (Johnson-Cook)
+  double reference_rate = 1.0;      ///< reference plastic strain rate, 1/s
+  double m = 0;                     ///< thermal softening exponent; 0 means no thermal term
+  double room_temperature = 293.0;  ///< K
+  double melt_temperature = 1356.0; ///< K
+  double specific_heat = 383.0;     ///< J/(kg K)
+  double taylor_quinney = 0.9;      ///< fraction of plastic work turned into heat
+  bool thermal() const { return model == StrengthModel::JohnsonCook && m > 0; }
+};
+
+/// Equation of state. Linear: p = K mu. Mie-Grueneisen (000, eq. 18) with internal energy.
+struct EosSpec {
+  EosModel model = EosModel::Linear;
+  double c0 = 0;      ///< bulk sound speed, m/s
+  double s = 0;       ///< slope of the shock-particle velocity relation
+  double gamma0 = 0;  ///< Grueneisen coefficient
+};
+
+/// Failure: a failed particle keeps no deviatoric stress and carries no tension.
+struct FailureSpec {
+  double plastic_strain = std::numeric_limits<double>::infinity();  ///< eps_p at failure
+  double pressure = -std::numeric_limits<double>::infinity();       ///< cut-off pressure, Pa
+  bool enabled() const {
+    return plastic_strain < std::numeric_limits<double>::infinity() ||
+           pressure > -std::numeric_limits<double>::infinity();
+  }
+};
+
+struct MaterialSpec {
+  std::string name;
+  double density = 0;          ///< reference density rho_0, kg/m^3
+  double youngs_modulus = 0;   ///< Pa
+  double poisson_ratio = 0;    ///< -
+  StrengthSpec strength;
+  EosSpec eos;
+  FailureSpec failure;
+  SourceLoc loc;
+  double shear_modulus() const { return youngs_modulus / (2 * (1 + poisson_ratio)); }
+  double bulk_modulus() const { return youngs_modulus / (3 * (1 - 2 * poisson_ratio)); }
+};
+
+enum class ShapeKind { Box, Cylinder, Sphere, Mesh };
+
+/// A body: a shape in its local frame, placed by scale, then rotation, then translation.
+/// Local frames: box centred on the origin; cylinder along +z from z = 0 to z = length,
+/// axis through the origin; sphere centred on the origin; mesh as in its file.
+/// In 2D scenes the shapes live in the x-y plane: box is a rectangle, sphere a disk.
+struct BodySpec {
+  std::string name;
+  int material = -1;             ///< index into Scene::materials
+  ShapeKind shape = ShapeKind::Box;
+  Vec3 size = Vec3::Zero();      ///< box edge lengths, m
+  double radius = 0;             ///< cylinder or sphere, m
+  double length = 0;             ///< cylinder, m
+  std::string mesh_path;         ///< STL, OFF or OBJ; relative paths are from the scene file
+  Vec3 scale = Vec3::Ones();     ///< applied first
+  Vec3 rotate_deg = Vec3::Zero();///< rotations about x, then y, then z, degrees
+  Vec3 translate = Vec3::Zero(); ///< applied last, m
+  Vec3 velocity = Vec3::Zero();  ///< initial velocity, m/s
+  int particles_per_cell = 2;    ///< per axis: n x n x n particles in each cell
+  SourceLoc loc;
+};
+
+struct GridSpec {
+  double cell_size = 0;        ///< h, m
+  bool domain_given = false;   ///< else fitted to the bodies with padding
+  Vec3 domain_min = Vec3::Zero();
+  Vec3 domain_max = Vec3::Zero();
+  double padding = 0;          ///< m, added around the bodies when the domain is fitted
+  SourceLoc loc;
+};
+
+enum class BoundaryType { Free, Slip, Fixed };
+/// Faces in the order x_min, x_max, y_min, y_max, z_min, z_max.
+struct BoundarySpec {
+  std::array<BoundaryType, 6> face{BoundaryType::Free, BoundaryType::Free, BoundaryType::Free,
+                                   BoundaryType::Free, BoundaryType::Free, BoundaryType::Free};
+};
+
+enum class Scheme { USF, USL, MUSL };
+/// What happens to a particle that leaves the domain.
+enum class OnExit { Stop, Remove };
+
+struct SolverSpec {
+  Scheme scheme = Scheme::MUSL;
+  double cfl = 0.5;                   ///< dt = cfl * h / max(c + |v|)
+  double end_time = 0;                ///< s
+  double dt_max = std::numeric_limits<double>::infinity();  ///< s
+  double bulk_linear = 0.06;          ///< artificial bulk viscosity, linear coefficient
+  double bulk_quadratic = 1.5;        ///< artificial bulk viscosity, quadratic coefficient
+  Vec3 gravity = Vec3::Zero();        ///< body force per unit mass, m/s^2
+  OnExit on_exit = OnExit::Stop;
+  double energy_growth_limit = 0.05;  ///< stop when total energy exceeds its reference by this
+  long max_steps = 0;                 ///< 0: no limit
+};
+
+enum class Precision { Float64, Float32 };
+
+struct OutputSpec {
+  int frames = 10;                   ///< frames written in (0, end_time], plus the initial one
+  double history_interval = 0;       ///< s; 0: every step
+  std::vector<std::string> fields;   ///< particle columns written in frames; empty: all
+  Precision precision = Precision::Float64;
+};
+
+struct Scene {
+  std::string source;      ///< file name (or "<stream>") the scene was read from
+  std::string directory;   ///< directory of the scene file, for relative mesh paths
+  std::string title;
+  int dimension = 3;       ///< 3, or 2 (plane strain, x-y plane)
+  std::vector<MaterialSpec> materials;
+  std::vector<BodySpec> bodies;
+  GridSpec grid;
+  BoundarySpec boundary;
+  SolverSpec solver;
+  OutputSpec output;
+  std::string toml;        ///< the scene as TOML text after overrides, as stored in streams
+
+  /// Index of a material by name, -1 if absent.
+  int material_index(const std::string& name) const;
+};
+
+/// Parses a scene from TOML text. `source` names it in messages; `directory` resolves relative
+/// mesh paths. `overrides` are "key=value" strings (--set) applied before validation; a value
+/// is read as TOML, or as a string when it is not valid TOML ("0.38mm").
+/// Throws InputError naming the file, line and key of the first mistake.
+Scene parse_scene(const std::string& toml_text, const std::string& source,
+                  const std::string& directory, const std::vector<std::string>& overrides);
+
+/// Reads and parses a scene file ("-" for stdin). Throws InputError.
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides);
+
+}  // namespace mpm

@@ -1,0 +1,158 @@
+#pragma once
+/// The one stream format for models and results (reference: docs/format.md).
+/// A 16-byte header, then records: fourcc type, u64 payload length, payload, CRC-32 of the
+/// type, length and payload. Frames are appended as a run goes, so a reader can follow a pipe
+/// frame by frame in bounded memory. Truncation and corruption are detected per record; the
+/// records before the damage stay readable. "-" means stdin/stdout.
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mpm/columns.hpp"
+#include "mpm/scene.hpp"
+
+namespace mpm {
+
+inline constexpr std::uint16_t kStreamVersionMajor = 1;  ///< readers refuse other majors
+inline constexpr std::uint16_t kStreamVersionMinor = 0;  ///< readers accept any minor
+
+/// Record types (little-endian fourcc).
+enum class RecordType : std::uint32_t {
+  Scene = 0x4E454353,    ///< "SCEN": the scene as TOML text, after overrides
+  Info = 0x4F464E49,     ///< "INFO": TOML text about the producer (tool, version, run settings)
+  Frame = 0x4D415246,    ///< "FRAM": particle columns at one time
+  History = 0x54534948,  ///< "HIST": rows of scalar time histories
+  End = 0x53444E45,      ///< "ENDS": status and message; absent when the writer was killed
+};
+/// "SCEN", "FRAM", ... for messages; "?xyz" style hex for unknown codes.
+std::string record_name(std::uint32_t type);
+
+/// Frame flags.
+enum FrameFlags : std::uint32_t {
+  kFrameModel = 1u,  ///< the initial state written by mpm-prep
+  kFrameFinal = 2u,  ///< the last frame of a completed run
+};
+
+/// Particle state at one time.
+struct Frame {
+  std::int64_t step = 0;
+  double time = 0;        ///< s
+  std::uint32_t flags = 0;
+  ColumnStore columns;
+};
+
+/// A block of rows of a time history; every value is f64.
+struct HistoryBlock {
+  std::vector<std::string> names;   ///< column names, e.g. "time", "dt", "kinetic"
+  std::vector<std::string> units;   ///< SI unit of each column
+  std::vector<double> values;       ///< row-major, rows() x names.size()
+  std::size_t rows() const { return names.empty() ? 0 : values.size() / names.size(); }
+};
+
+/// Writes a stream to a file or stdout ("-"). Each record is flushed when written, so a
+/// reader at the other end of a pipe sees frames as they come.
+class StreamWriter {
+ public:
+  explicit StreamWriter(const std::string& path);
+  ~StreamWriter();
+  StreamWriter(const StreamWriter&) = delete;
+  StreamWriter& operator=(const StreamWriter&) = delete;
+
+  void write_text(RecordType type, const std::string& text);
+  /// Writes the columns named in `fields` (all when empty; unknown names throw InputError).
+  /// Float32 precision stores f64 columns as f32, except "x" (positions keep f64).
+  void write_frame(const Frame& frame, const std::vector<std::string>& fields = {},
+                   Precision precision = Precision::Float64);
+  void write_history(const HistoryBlock& block);
+  void write_end(int status, const std::string& message);
+  std::uint64_t bytes_written() const { return offset_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  void begin_record(RecordType type, std::uint64_t length);
+  void put(const void* data, std::size_t n);  ///< writes and updates the running CRC
+  void end_record();
+  std::string path_;
+  std::FILE* f_ = nullptr;
+  bool owns_ = false;
+  std::uint64_t offset_ = 0;
+  std::uint32_t crc_ = 0;
+};
+
+/// Reads a stream sequentially from a file or stdin ("-").
+class StreamReader {
+ public:
+  /// Opens and checks the header; throws StreamError (bad magic, other major version).
+  explicit StreamReader(const std::string& path);
+  ~StreamReader();
+  StreamReader(const StreamReader&) = delete;
+  StreamReader& operator=(const StreamReader&) = delete;
+
+  /// One record. For frames, use read_frame() instead of payload.
+  struct Record {
+    std::uint32_t type = 0;
+    std::uint64_t offset = 0;        ///< byte offset of the record in the stream
+    std::vector<std::byte> payload;  ///< empty for frames read through read_frame()
+  };
+
+  /// Reads the next record's type; false at the end of the stream. Must be followed by
+  /// read_payload(), read_frame() or skip(). Throws StreamError on a truncated header.
+  bool next(std::uint32_t& type);
+  /// The payload of the current record (checked against its CRC).
+  std::vector<std::byte> read_payload();
+  /// The current record as a frame (must be a FRAM record), decoded straight into columns;
+  /// f32 columns are widened to f64. Checked against its CRC.
+  Frame read_frame();
+  /// Skips the current record (still checks its CRC).
+  void skip();
+
+  /// Decoders for payloads.
+  static std::string decode_text(const std::vector<std::byte>& payload);
+  static HistoryBlock decode_history(const std::vector<std::byte>& payload);
+  static std::pair<int, std::string> decode_end(const std::vector<std::byte>& payload);
+
+  const std::string& path() const { return path_; }
+  std::uint64_t offset() const { return offset_; }
+  std::size_t records_read() const { return records_; }
+  std::size_t frames_read() const { return frames_; }
+
+ private:
+  std::string path_;
+  std::FILE* f_ = nullptr;
+  bool owns_ = false;
+  std::uint64_t offset_ = 0;
+  std::uint64_t record_offset_ = 0;
+  std::uint32_t type_ = 0;
+  std::uint64_t length_ = 0;
+  bool pending_ = false;
+  std::size_t records_ = 0, frames_ = 0;
+};
+
+/// Everything in a stream, delivered record by record. Every callback may be empty.
+struct StreamVisitor {
+  std::function<void(const std::string&)> scene;
+  std::function<void(const std::string&)> info;
+  std::function<void(Frame&&)> frame;
+  std::function<void(HistoryBlock&&)> history;
+  std::function<void(int, const std::string&)> end;
+  bool want_frames = true;  ///< false: frames are skipped without decoding
+};
+
+/// Result of reading a whole stream.
+struct StreamSummary {
+  std::size_t frames = 0;
+  bool ended = false;          ///< an END record was seen
+  int end_status = 0;
+  std::string end_message;
+  std::string damage;          ///< empty, or what was wrong (truncation, CRC mismatch)
+};
+
+/// Reads a stream to its end, calling the visitor. On damage, stops there and returns the
+/// damage message in the summary instead of throwing: the records before it were delivered.
+/// Throws StreamError only when the header itself is bad.
+StreamSummary read_stream(const std::string& path, const StreamVisitor& visitor);
+
+}  // namespace mpm

@@ -1,0 +1,4 @@
+// mpm-post: entry point (filled in by the toolchain issue).
+#include <cstdio>
+#include "mpm/version.hpp"
+int main() { std::printf("mpm-post %s\n", mpm::kVersion); return 0; }
