@@ -1,4 +1,402 @@
-// mpm-post: entry point (filled in by the toolchain issue).
+// mpm-post: what users report from a result stream.
+//   mpm-post summary run.mpm            mpm-post history run.mpm -o history.csv
+//   mpm-post vtk run.mpm -o out/        mpm-post taylor run.mpm --json
+//   mpm-post render run.mpm -o bar.png --field eps_p
+#include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+
+#include "mpm/cli.hpp"
+#include "mpm/error.hpp"
+#include "mpm/post.hpp"
+#include "mpm/stream.hpp"
+#include "mpm/units.hpp"
 #include "mpm/version.hpp"
-int main() { std::printf("mpm-post %s\n", mpm::kVersion); return 0; }
+#include "mpm/vtk/vtk_output.hpp"
+
+namespace {
+
+using namespace mpm;
+
+std::string input_name(const std::string& path) { return path == "-" ? "stdin" : path; }
+
+/// What every subcommand says after reading: damage (exit 2), an unfinished or failed run.
+int conclude(const std::string& path, const StreamSummary& s, std::size_t frames_used) {
+  if (!s.damage.empty()) {
+    std::fprintf(stderr, "mpm-post: error: %s; used the %zu frame(s) before it\n", s.damage.c_str(),
+                 frames_used);
+    return kExitBadInput;
+  }
+  if (!s.ended) {
+    std::fprintf(stderr,
+                 "mpm-post: error: %s: the stream ends without an end record: its producer stopped "
+                 "before finishing (killed, or still running); used the %zu frame(s) it holds\n",
+                 input_name(path).c_str(), frames_used);
+    return kExitBadInput;
+  }
+  if (s.end_status != 0) {
+    std::fprintf(stderr, "mpm-post: warning: the run ended with status %d: %s\n", s.end_status,
+                 s.end_message.c_str());
+    return s.end_status;
+  }
+  return kExitOk;
+}
+
+Scene scene_of(const std::string& text, const std::string& path) {
+  if (text.empty()) throw StreamError(input_name(path), "the stream holds no scene record");
+  return parse_scene(text, input_name(path) + " (scene)", "", {});
+}
+
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  char b[40];
+  std::snprintf(b, sizeof b, "%.10g", v);
+  return b;
+}
+
+std::string json_string(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\', o += c;
+    else if (c == '\n') o += "\\n";
+    else if (static_cast<unsigned char>(c) < 0x20) o += ' ';
+    else o += c;
+  }
+  return o + "\"";
+}
+
+double quantity(const std::string& text, const Dimension& dim, const std::string& option) {
+  try {
+    const Quantity q = parse_quantity(text);
+    if (!(q.dim == dim)) throw std::invalid_argument("expected " + describe(dim));
+    return q.value;
+  } catch (const std::invalid_argument& e) {
+    throw InputError(option, std::string(e.what()) + " in '" + text + "'");
+  }
+}
+
+// summary ---------------------------------------------------------------------------------
+int cmd_summary(const std::string& path, bool json) {
+  std::string scene_text;
+  std::vector<std::string> infos;
+  struct F {
+    std::int64_t step;
+    double time;
+    std::size_t n;
+    std::uint32_t flags;
+  };
+  std::vector<F> frames;
+  std::size_t hist_rows = 0;
+  std::vector<std::string> hist_names;
+  StreamVisitor v;
+  v.scene = [&](const std::string& t) { scene_text = t; };
+  v.info = [&](const std::string& t) { infos.push_back(t); };
+  v.frame = [&](Frame&& f) { frames.push_back({f.step, f.time, f.columns.size(), f.flags}); };
+  v.history = [&](HistoryBlock&& h) {
+    hist_rows += h.rows();
+    if (hist_names.empty()) hist_names = h.names;
+  };
+  const StreamSummary s = read_stream(path, v);
+  std::string title;
+  int dim = 0;
+  if (!scene_text.empty()) {
+    const Scene sc = scene_of(scene_text, path);
+    title = sc.title;
+    dim = sc.dimension;
+  }
+  if (json) {
+    std::printf("{\"input\": %s, \"title\": %s, \"dimension\": %d, \"frames\": [",
+                json_string(input_name(path)).c_str(), json_string(title).c_str(), dim);
+    for (std::size_t k = 0; k < frames.size(); ++k)
+      std::printf("%s{\"step\": %lld, \"time\": %s, \"particles\": %zu}", k ? ", " : "",
+                  (long long)frames[k].step, json_number(frames[k].time).c_str(), frames[k].n);
+    std::printf("], \"history_rows\": %zu, \"ended\": %s, \"status\": %d, \"message\": %s, "
+                "\"damage\": %s}\n",
+                hist_rows, s.ended ? "true" : "false", s.end_status,
+                json_string(s.end_message).c_str(), json_string(s.damage).c_str());
+  } else {
+    std::printf("stream: %s\n", input_name(path).c_str());
+    if (!title.empty()) std::printf("scene: %s (%dD)\n", title.c_str(), dim);
+    std::printf("frames: %zu\n", frames.size());
+    std::printf("  %8s %14s %12s\n", "step", "time (us)", "particles");
+    for (const auto& f : frames)
+      std::printf("  %8lld %14.4f %12zu%s\n", (long long)f.step, f.time * 1e6, f.n,
+                  (f.flags & kFrameModel) ? "  (model)" : (f.flags & kFrameFinal) ? "  (final)" : "");
+    std::printf("history: %zu rows", hist_rows);
+    if (!hist_names.empty()) {
+      std::printf(" of");
+      for (auto& n : hist_names) std::printf(" %s", n.c_str());
+    }
+    std::printf("\nend: %s\n", s.ended ? ("status " + std::to_string(s.end_status) + ", " + s.end_message).c_str()
+                                       : "missing (the producer stopped early or is still running)");
+    if (!s.damage.empty()) std::printf("damage: %s\n", s.damage.c_str());
+  }
+  if (!s.damage.empty()) {
+    std::fprintf(stderr, "mpm-post: error: %s\n", s.damage.c_str());
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
+// history ---------------------------------------------------------------------------------
+int cmd_history(const std::string& path, const std::string& out, const std::vector<std::string>& cols) {
+  std::vector<std::string> names;
+  std::vector<int> pick;
+  std::FILE* f = out == "-" ? stdout : std::fopen(out.c_str(), "w");
+  if (!f) throw IoError("cannot write '" + out + "': " + std::strerror(errno));
+  std::size_t frames = 0;
+  StreamVisitor v;
+  v.want_frames = false;
+  v.frame = [&](Frame&&) { ++frames; };
+  v.history = [&](HistoryBlock&& h) {
+    if (names.empty()) {
+      names = h.names;
+      if (cols.empty()) {
+        for (std::size_t k = 0; k < names.size(); ++k) pick.push_back(int(k));
+      } else {
+        for (const auto& c : cols) {
+          auto it = std::find(names.begin(), names.end(), c);
+          if (it == names.end()) {
+            std::string known;
+            for (auto& n : names) known += (known.empty() ? "" : ", ") + n;
+            throw InputError("--columns", "unknown history column '" + c + "' (known: " + known + ")");
+          }
+          pick.push_back(int(it - names.begin()));
+        }
+      }
+      for (std::size_t k = 0; k < pick.size(); ++k)
+        std::fprintf(f, "%s%s", k ? "," : "", names[pick[k]].c_str());
+      std::fprintf(f, "\n");
+    }
+    const std::size_t nc = h.names.size();
+    for (std::size_t r = 0; r < h.rows(); ++r) {
+      for (std::size_t k = 0; k < pick.size(); ++k)
+        std::fprintf(f, "%s%.10g", k ? "," : "", h.values[r * nc + pick[k]]);
+      std::fprintf(f, "\n");
+    }
+  };
+  const StreamSummary s = read_stream(path, v);
+  if (f != stdout) std::fclose(f);
+  else std::fflush(stdout);
+  return conclude(path, s, frames);
+}
+
+// vtk -------------------------------------------------------------------------------------
+int cmd_vtk(const std::string& path, const std::string& dir, const std::string& name, int every) {
+  std::filesystem::create_directories(dir);
+  std::vector<std::pair<double, std::string>> entries;
+  std::size_t index = 0;
+  StreamVisitor v;
+  v.frame = [&](Frame&& f) {
+    if (index++ % std::size_t(every) != 0 && !(f.flags & kFrameFinal)) return;
+    const int dim = f.columns.at("x").info().components;
+    char file[256];
+    std::snprintf(file, sizeof file, "%s_%04zu.vtu", name.c_str(), entries.size());
+    write_vtu(f, dim, (std::filesystem::path(dir) / file).string());
+    entries.emplace_back(f.time, file);
+    write_pvd(entries, (std::filesystem::path(dir) / (name + ".pvd")).string());
+  };
+  const StreamSummary s = read_stream(path, v);
+  std::fprintf(stderr, "mpm-post: wrote %zu frame(s) and %s\n", entries.size(),
+               (std::filesystem::path(dir) / (name + ".pvd")).string().c_str());
+  return conclude(path, s, index);
+}
+
+// taylor ----------------------------------------------------------------------------------
+struct TaylorArgs {
+  std::string body, axis, wall, expect_L, expect_D;
+  bool surface = false, json = false;
+};
+
+int cmd_taylor(const std::string& path, const TaylorArgs& a) {
+  std::string scene_text;
+  std::optional<TaylorMeter> meter;
+  std::optional<TaylorResult> first, last;
+  std::size_t frames = 0;
+  TaylorOptions opt;
+  opt.body = a.body;
+  opt.surface = a.surface;
+  if (!a.axis.empty()) {
+    if (a.axis != "x" && a.axis != "y" && a.axis != "z")
+      throw InputError("--axis", "expected x, y or z, got '" + a.axis + "'");
+    opt.axis = a.axis[0] - 'x';
+  }
+  if (!a.wall.empty()) opt.wall = quantity(a.wall, dim::length, "--wall");
+  StreamVisitor v;
+  v.scene = [&](const std::string& t) {
+    scene_text = t;
+    meter.emplace(scene_of(t, path), opt);
+  };
+  v.frame = [&](Frame&& f) {
+    ++frames;
+    if (!meter) throw StreamError(input_name(path), "a frame comes before the scene record");
+    const TaylorResult r = meter->measure(f);
+    if (!first) first = r;
+    last = r;
+  };
+  const StreamSummary s = read_stream(path, v);
+  if (!last) {
+    std::fprintf(stderr, "mpm-post: error: %s holds no frame to measure%s%s\n",
+                 input_name(path).c_str(), s.damage.empty() ? "" : ": ", s.damage.c_str());
+    return kExitBadInput;
+  }
+  TaylorResult r = *last;
+  r.L0 = first->L;
+  r.D0 = first->D;
+  std::optional<double> eL, eD;
+  if (!a.expect_L.empty()) eL = quantity(a.expect_L, dim::length, "--expect-L");
+  if (!a.expect_D.empty()) eD = quantity(a.expect_D, dim::length, "--expect-D");
+  if (a.json) {
+    std::printf("{\"time\": %s, \"measure\": %s, \"L\": %s, \"D\": %s, \"L0\": %s, \"D0\": %s, "
+                "\"axis\": \"%c\", \"wall\": %s, \"spacing\": %s, \"particles\": %zu",
+                json_number(r.time).c_str(), json_string(r.measure).c_str(), json_number(r.L).c_str(),
+                json_number(r.D).c_str(), json_number(r.L0).c_str(), json_number(r.D0).c_str(),
+                "xyz"[r.axis], json_number(r.wall).c_str(), json_number(r.spacing).c_str(), r.particles);
+    if (eL) std::printf(", \"expected_L\": %s, \"error_L\": %s", json_number(*eL).c_str(), json_number(r.L / *eL - 1).c_str());
+    if (eD) std::printf(", \"expected_D\": %s, \"error_D\": %s", json_number(*eD).c_str(), json_number(r.D / *eD - 1).c_str());
+    std::printf("}\n");
+  } else {
+    std::printf("Taylor bar at t = %.4g us (%s; axis %c, wall at %.4g mm, %zu particles)\n",
+                r.time * 1e6, r.measure == "centres" ? "particle centres" : "surface: centres + half a spacing",
+                "xyz"[r.axis], r.wall * 1e3, r.particles);
+    std::printf("  L = %.3f mm", r.L * 1e3);
+    if (eL) std::printf("   expected %.3f mm, %+.2f%%", *eL * 1e3, 100 * (r.L / *eL - 1));
+    std::printf("   (L0 = %.3f mm, L/L0 = %.4f)\n", r.L0 * 1e3, r.L / r.L0);
+    std::printf("  D = %.3f mm", r.D * 1e3);
+    if (eD) std::printf("   expected %.3f mm, %+.2f%%", *eD * 1e3, 100 * (r.D / *eD - 1));
+    std::printf("   (D0 = %.3f mm, D/D0 = %.4f)\n", r.D0 * 1e3, r.D / r.D0);
+  }
+  std::fflush(stdout);
+  return conclude(path, s, frames);
+}
+
+// render ----------------------------------------------------------------------------------
+struct RenderArgs {
+  std::string output = "frame.png", frame = "last", time, size = "1200x900", range;
+  RenderOptions opt;
+};
+
+int cmd_render(const std::string& path, RenderArgs& a) {
+  RenderOptions& o = a.opt;
+  if (std::sscanf(a.size.c_str(), "%dx%d", &o.width, &o.height) != 2 || o.width < 16 || o.height < 16)
+    throw InputError("--size", "expected WIDTHxHEIGHT in pixels, got '" + a.size + "'");
+  if (!a.range.empty() && std::sscanf(a.range.c_str(), "%lf:%lf", &o.range_min, &o.range_max) == 2)
+    o.range_given = true;
+  else if (!a.range.empty())
+    throw InputError("--range", "expected MIN:MAX in the field's SI unit, got '" + a.range + "'");
+  long want = -1;
+  if (a.frame != "last") {
+    char* end = nullptr;
+    want = std::strtol(a.frame.c_str(), &end, 10);
+    if (!end || *end || want < 0) throw InputError("--frame", "expected a frame index or 'last', got '" + a.frame + "'");
+  }
+  std::optional<double> at;
+  if (!a.time.empty()) at = quantity(a.time, dim::time, "--time");
+  std::optional<Frame> chosen;
+  long index = 0;
+  double best = 1e300;
+  StreamVisitor v;
+  v.frame = [&](Frame&& f) {
+    const long k = index++;
+    if (at) {
+      const double d = std::abs(f.time - *at);
+      if (d < best) best = d, chosen = std::move(f);
+    } else if (want < 0 || k == want) {
+      chosen = std::move(f);
+    }
+  };
+  const StreamSummary s = read_stream(path, v);
+  if (!chosen) {
+    std::fprintf(stderr, "mpm-post: error: %s has no frame %s (it holds %ld)\n", input_name(path).c_str(),
+                 a.frame.c_str(), index);
+    return kExitBadInput;
+  }
+  const int dim = chosen->columns.at("x").info().components;
+  render_png(*chosen, dim, o, a.output);
+  std::fprintf(stderr, "mpm-post: wrote %s (frame at t = %.4g us, %zu particles, coloured by %s)\n",
+               a.output.c_str(), chosen->time * 1e6, chosen->columns.size(), o.field.c_str());
+  return conclude(path, s, std::size_t(index));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"mpm-post: read a result stream (from mpm-run) and report.\n"
+               "INPUT is a stream file or - for stdin. --json on measurements prints JSON.\n"
+               "Exit status: 0 done, 2 bad input or damaged stream (the frames before the\n"
+               "damage are still used), 3 the run was unstable, 4 write failure.",
+               "mpm-post"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("mpm-post ") + mpm::kVersion);
+  std::string input = "-";
+
+  auto* summary = app.add_subcommand("summary", "what a stream holds: frames, history, end status");
+  bool summary_json = false;
+  summary->add_option("input", input, "stream, - for stdin")->capture_default_str();
+  summary->add_flag("--json", summary_json, "print JSON");
+
+  auto* history = app.add_subcommand("history", "time histories as CSV (energies, momentum, wall forces)");
+  std::string hist_out = "-";
+  std::vector<std::string> hist_cols;
+  history->add_option("input", input, "stream, - for stdin")->capture_default_str();
+  history->add_option("-o,--output", hist_out, "CSV file, - for stdout")->capture_default_str();
+  history->add_option("--columns", hist_cols, "columns to print (default all)")->delimiter(',');
+
+  auto* vtk = app.add_subcommand("vtk", "ParaView files: a .vtu per frame and a .pvd series");
+  std::string vtk_dir = "vtk", vtk_name = "frame";
+  int vtk_every = 1;
+  vtk->add_option("input", input, "stream, - for stdin")->capture_default_str();
+  vtk->add_option("-o,--output", vtk_dir, "directory")->capture_default_str();
+  vtk->add_option("--name", vtk_name, "file name prefix")->capture_default_str();
+  vtk->add_option("--every", vtk_every, "write every Nth frame (the final one always)")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+
+  auto* taylor = app.add_subcommand("taylor", "final length L and foot diameter D of a bar against a wall");
+  TaylorArgs ta;
+  taylor->add_option("input", input, "stream, - for stdin")->capture_default_str();
+  taylor->add_option("--body", ta.body, "body name (default: the first)");
+  taylor->add_option("--axis", ta.axis, "bar axis x, y or z (default: its longest extent)");
+  taylor->add_option("--wall", ta.wall, "wall position along the axis, e.g. \"0 mm\" (default: the constrained domain face)");
+  taylor->add_flag("--surface", ta.surface, "measure the surface (centres + half a particle spacing) instead of particle centres");
+  taylor->add_option("--expect-L", ta.expect_L, "reference length, e.g. \"16.2 mm\", to print the difference");
+  taylor->add_option("--expect-D", ta.expect_D, "reference diameter, e.g. \"13.5 mm\"");
+  taylor->add_flag("--json", ta.json, "print JSON (SI units)");
+
+  auto* render = app.add_subcommand("render", "PNG picture of a frame, off-screen (works without a display)");
+  RenderArgs ra;
+  render->add_option("input", input, "stream, - for stdin")->capture_default_str();
+  render->add_option("-o,--output", ra.output, "PNG file")->capture_default_str();
+  render->add_option("--frame", ra.frame, "frame index (0 = first) or 'last'")->capture_default_str();
+  render->add_option("--time", ra.time, "the frame nearest this time, e.g. \"30.6 us\"");
+  render->add_option("--field", ra.opt.field, "colour by: a column (eps_p, rho, e, ...) or pressure, von_mises, speed")->capture_default_str();
+  render->add_option("--component", ra.opt.component, "component of a vector field (-1: magnitude)");
+  render->add_option("--view", ra.opt.view, "side, front, top or iso")
+      ->check(CLI::IsMember({"side", "front", "top", "iso"}))->capture_default_str();
+  render->add_option("--clip", ra.opt.clip, "keep one side of a plane through the centroid, e.g. \"y>0\"");
+  render->add_option("--size", ra.size, "WIDTHxHEIGHT in pixels")->capture_default_str();
+  render->add_option("--range", ra.range, "colour range MIN:MAX (SI units)");
+  render->add_option("--title", ra.opt.title, "title text");
+  render->add_option("--radius", ra.opt.point_radius, "particle radius in m (default from mass and density)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : mpm::kExitBadInput;
+  }
+  return mpm::guarded_main("mpm-post", [&]() -> int {
+    mpm::ignore_sigpipe();
+    if (*summary) return cmd_summary(input, summary_json);
+    if (*history) return cmd_history(input, hist_out, hist_cols);
+    if (*vtk) return cmd_vtk(input, vtk_dir, vtk_name, vtk_every);
+    if (*taylor) return cmd_taylor(input, ta);
+    if (*render) {
+      mpm::ensure_display(argc, argv);  // before reading: a re-run under xvfb reads stdin again
+      return cmd_render(input, ra);
+    }
+    return mpm::kExitBadInput;
+  });
+}

@@ -1,4 +1,35 @@
-// mpm-prep: entry point (filled in by the toolchain issue).
-#include <cstdio>
+// mpm-prep: scene file to model stream.
+//   mpm-prep examples/taylor-bar/scene.toml -o taylor.model
+//   mpm-prep scene.toml --set grid.cell_size="0.38 mm" | mpm-run | mpm-post taylor -
+#include <CLI/CLI.hpp>
+
+#include "mpm/cli.hpp"
+#include "mpm/error.hpp"
+#include "mpm/prep.hpp"
 #include "mpm/version.hpp"
-int main() { std::printf("mpm-prep %s\n", mpm::kVersion); return 0; }
+
+int main(int argc, char** argv) {
+  CLI::App app{"mpm-prep: turn a scene (TOML, see docs/scene.md) into a model stream of\n"
+               "particles for mpm-run. Prints a summary on stderr. Exit status: 0 done,\n"
+               "2 bad input, 4 write failure.",
+               "mpm-prep"};
+  mpm::PrepOptions opt;
+  app.add_option("scene", opt.scene, "scene file, - for stdin")->required();
+  app.add_option("-o,--output", opt.output, "model stream, - for stdout")->capture_default_str();
+  app.add_option("--set", opt.overrides,
+                 "override a scene value, KEY=VALUE (e.g. grid.cell_size=0.38mm); repeatable")
+      ->allow_extra_args(false);
+  app.add_flag("-q,--quiet", opt.quiet, "no summary on stderr");
+  app.set_version_flag("--version", std::string("mpm-prep ") + mpm::kVersion);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : mpm::kExitBadInput;
+  }
+  return mpm::guarded_main("mpm-prep", [&] {
+    mpm::ignore_sigpipe();
+    mpm::refuse_terminal_output(opt.output, "the model stream");
+    return mpm::prepare_model(opt);
+  });
+}

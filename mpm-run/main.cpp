@@ -1,4 +1,45 @@
-// mpm-run: entry point (filled in by the toolchain issue).
-#include <cstdio>
+// mpm-run: the solver. Reads a model stream (from mpm-prep), writes a result stream.
+//   mpm-prep scene.toml | mpm-run --threads 2 --stats | mpm-post taylor -
+#include <CLI/CLI.hpp>
+
+#include "mpm/cli.hpp"
+#include "mpm/error.hpp"
+#include "mpm/run.hpp"
 #include "mpm/version.hpp"
-int main() { std::printf("mpm-run %s\n", mpm::kVersion); return 0; }
+
+int main(int argc, char** argv) {
+  CLI::App app{"mpm-run: explicit material point method solver.\n"
+               "Reads a model stream (from mpm-prep) and writes a result stream of frames and\n"
+               "histories (for mpm-post). Exit status: 0 done, 2 bad input, 3 unstable run,\n"
+               "4 write failure, 128+N killed by signal N.",
+               "mpm-run"};
+  mpm::RunOptions opt;
+  std::string progress = "auto";
+  app.add_option("input", opt.input, "model stream, - for stdin")->capture_default_str();
+  app.add_option("-o,--output", opt.output, "result stream, - for stdout")->capture_default_str();
+  app.add_option("-t,--threads", opt.threads, "OpenMP threads (default: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--set", opt.overrides,
+                 "override a scene value, KEY=VALUE (e.g. solver.cfl=0.3); repeatable")
+      ->allow_extra_args(false);
+  app.add_flag("--stats", opt.stats, "print the per-kernel time table and throughput at the end");
+  app.add_option("--progress", progress, "progress on stderr: auto, bar, lines or none")
+      ->check(CLI::IsMember({"auto", "bar", "lines", "none"}))
+      ->capture_default_str();
+  app.set_version_flag("--version", std::string("mpm-run ") + mpm::kVersion);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : mpm::kExitBadInput;
+  }
+  opt.progress = progress == "bar"     ? mpm::ProgressMode::Bar
+                 : progress == "lines" ? mpm::ProgressMode::Lines
+                 : progress == "none"  ? mpm::ProgressMode::None
+                                       : mpm::ProgressMode::Auto;
+  return mpm::guarded_main("mpm-run", [&] {
+    mpm::ignore_sigpipe();
+    mpm::refuse_terminal_output(opt.output, "the result stream");
+    return mpm::run_model(opt);
+  });
+}

@@ -1,0 +1,39 @@
+#include "mpm/cli.hpp"
+
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+#include <new>
+
+#include "mpm/error.hpp"
+
+namespace mpm {
+
+int guarded_main(const char* tool, const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "%s: error: %s\n", tool, e.what());
+    return kExitBadInput;
+  } catch (const IoError& e) {
+    std::fprintf(stderr, "%s: error: %s\n", tool, e.what());
+    return kExitIo;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "%s: error: out of memory\n", tool);
+    return kExitInternal;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: internal error: %s\n", tool, e.what());
+    return kExitInternal;
+  }
+}
+
+void refuse_terminal_output(const std::string& path, const char* what) {
+  if (path == "-" && isatty(1))
+    throw InputError("-o", std::string("standard output is a terminal; ") + what +
+                               " is binary: pipe it into the next tool or write it with -o FILE");
+}
+
+void ignore_sigpipe() { std::signal(SIGPIPE, SIG_IGN); }
+
+}  // namespace mpm

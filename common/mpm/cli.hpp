@@ -1,0 +1,19 @@
+#pragma once
+/// What the three tools share on the command line: error reporting and exit statuses.
+#include <functional>
+#include <string>
+
+namespace mpm {
+
+/// Runs a tool's body; prints "<tool>: error: <message>" for exceptions and maps them to
+/// exit statuses: InputError/StreamError 2, IoError 4, anything else 1.
+int guarded_main(const char* tool, const std::function<int()>& body);
+
+/// Throws InputError when `path` is "-" and stdout is a terminal (binary output would be
+/// garbage there).
+void refuse_terminal_output(const std::string& path, const char* what);
+
+/// Ignores SIGPIPE so that a closed pipe shows up as a write error (IoError) with a message.
+void ignore_sigpipe();
+
+}  // namespace mpm

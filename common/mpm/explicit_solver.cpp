@@ -1,0 +1,613 @@
+// Explicit MPM. The time step is ExplicitSolver::step, right below: a few named kernels whose
+// order is the only difference between USF, USL and MUSL. The kernels follow it.
+#include "mpm/explicit_solver.hpp"
+
+#include "mpm/error.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace mpm {
+
+template <int D>
+void ExplicitSolver<D>::step(double dt) {
+  dt_ = dt;
+  if (need_sort_) sort_particles();  // cell order; the grid window follows the material
+  switch (scheme_) {
+    case Scheme::USF:  // update stress first (004, section 3.4)
+      p2g<kMass | kMomentum>();        // m_i, p_i (004, eqs. 24-25)
+      grid_velocity();                 // v_i = p_i / m_i, boundary conditions
+      update_stress(grid_.v, false);   // strain rate, spin, stress (004, eqs. 26-27)
+      p2g<kForce>();                   // f_i (004, eqs. 28-29)
+      grid_update(false);              // p_i += f_i dt (004, eq. 30)
+      g2p<false, true>();              // v_p, x_p (004, eqs. 9-10)
+      break;
+    case Scheme::USL:  // update stress last
+      p2g<kMass | kMomentum | kForce>();
+      grid_update(true);
+      g2p<false, false>();
+      update_stress(grid_.v, true);
+      break;
+    case Scheme::MUSL:  // update stress last, from remapped velocities (000, section 2)
+      p2g<kMass | kMomentum | kForce>();  // m_i, p_i, f_i (000, eqs. 1-5)
+      grid_update(true);                  // p_i += f_i dt (000, eq. 6)
+      g2p<true, false>();                 // v_p (eqs. 8, 10); remap m_p v_p (eq. 11)
+      grid_remap();                       // v_i = remapped p_i / m_i
+      update_stress(grid_.v_remap, true); // x_p (eqs. 7, 9); stress (eqs. 12-15)
+      break;
+  }
+  time_ += dt;
+  ++steps_;
+  particle_steps_ += double(particles_.size());
+  check_energy();
+}
+
+// ------------------------------------------------------------------------------------------
+// Construction and bookkeeping
+
+InstabilityError::InstabilityError(long step_, double time_, long particle_, const std::string& cause_)
+    : std::runtime_error("unstable at step " + std::to_string(step_) + " (t = " + [&] {
+        char b[32];
+        std::snprintf(b, sizeof b, "%.6g s", time_);
+        return std::string(b);
+      }() + (particle_ >= 0 ? "), particle " + std::to_string(particle_) : ")") + ": " + cause_),
+      step(step_),
+      time(time_),
+      particle(particle_),
+      cause(cause_) {}
+
+/// Per-chunk results of a particle kernel, reduced in chunk order so that sums do not depend
+/// on the thread count.
+template <int D>
+struct ExplicitSolver<D>::ChunkStats {
+  double kinetic = 0, internal = 0, work = 0;
+  Vec3 momentum = Vec3::Zero();
+  double dt_min = std::numeric_limits<double>::infinity();
+  long off_bin = 0, strays = 0;
+  bool out_of_window = false;
+  std::vector<std::uint32_t> exits;
+  long fault = -1;  ///< particle index of the first fault
+  std::string cause;
+};
+
+/// Per-thread scratch of the stress kernel.
+template <int D>
+struct ExplicitSolver<D>::StressScratch {
+  Mat3 L[kBlock];
+  double c[kBlock];
+  BlockScratch S;
+};
+
+template <int D>
+ExplicitSolver<D>::ExplicitSolver(const Scene& scene, const Lattice& lattice, ColumnStore& particles)
+    : scene_(scene),
+      particles_(particles),
+      grid_(lattice, scene.boundary),
+      scheme_(scene.solver.scheme),
+      cfl_(scene.solver.cfl),
+      dt_max_(scene.solver.dt_max) {
+  prepare_columns(particles_, scene_);
+  for (const auto& m : scene_.materials) materials_.emplace_back(m, scene_.solver);
+  for (int a = 0; a < D; ++a) gravity_[a] = scene_.solver.gravity[a];
+  const int threads = omp_get_max_threads();
+  strays_.resize(threads);
+  scratch_.resize(threads);
+  for (auto& s : scratch_) s = std::make_unique<StressScratch>();
+
+  // Every particle must start inside the domain.
+  ParticleView<D> p = view<D>(particles_);
+  double m_min = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < p.n; ++i) {
+    IVec<D> cell;
+    Vec<D> xi;
+    grid_.locate(p.x[i], cell, xi);
+    if (!p.x[i].allFinite() || !grid_.in_domain(cell))
+      throw InputError("model", "particle " + std::to_string(p.id[i]) +
+                                    " lies outside the domain of the grid");
+    m_min = std::min(m_min, p.m[i]);
+  }
+  node_mass_floor_ = 1e-14 * (p.n ? m_min : 1.0);
+  sort_particles();
+
+  // Initial energies and the first stable time step.
+  p = view<D>(particles_);
+  double speed = 0;
+  for (std::size_t i = 0; i < p.n; ++i) {
+    balance_.kinetic += 0.5 * p.m[i] * p.v[i].squaredNorm();
+    balance_.internal += p.m[i] * p.e[i];
+    for (int a = 0; a < D; ++a) balance_.momentum[a] += p.m[i] * p.v[i][a];
+    speed = std::max(speed, materials_[p.material[i]].reference_wave_speed() + p.v[i].norm());
+  }
+  total0_ = balance_.total();
+  energy_scale_ = std::max(std::abs(total0_), balance_.kinetic);
+  stable_dt_ = std::min(dt_max_, speed > 0 ? cfl_ * grid_.h() / speed : dt_max_);
+}
+
+template <int D>
+ExplicitSolver<D>::~ExplicitSolver() = default;
+
+template <int D>
+void ExplicitSolver<D>::sort_particles() {
+  ScopedTimer timer(timers_, timers_.id("sort"));
+  if (!exits_.empty()) {
+    // Particles that left the domain take their energy with them (balance_.removed).
+    const ParticleView<D> p = view<D>(particles_);
+    for (auto i : exits_) {
+      balance_.removed += 0.5 * p.m[i] * p.v[i].squaredNorm() + p.m[i] * p.e[i];
+      balance_.kinetic -= 0.5 * p.m[i] * p.v[i].squaredNorm();
+      balance_.internal -= p.m[i] * p.e[i];
+    }
+    std::sort(exits_.begin(), exits_.end());
+    exits_.erase(std::unique(exits_.begin(), exits_.end()), exits_.end());
+    removed_count_ += exits_.size();
+  }
+  binning_.sort<D>(particles_, grid_, exits_);
+  exits_.clear();
+  need_sort_ = false;
+}
+
+template <int D>
+void ExplicitSolver<D>::check_energy() {
+  const double total = balance_.total();
+  energy_scale_ = std::max({energy_scale_, balance_.kinetic, std::abs(balance_.external_work)});
+  const double growth = total - total0_;
+  if (growth > scene_.solver.energy_growth_limit * energy_scale_ && energy_scale_ > 0) {
+    char msg[256];
+    std::snprintf(msg, sizeof msg,
+                  "total energy grew by %.3g J, %.1f%% of its scale %.3g J (limit "
+                  "solver.energy_growth_limit = %g): lower solver.cfl",
+                  growth, 100.0 * growth / energy_scale_, energy_scale_,
+                  scene_.solver.energy_growth_limit);
+    throw InstabilityError(steps_, time_, -1, msg);
+  }
+}
+
+/// Reduces the per-chunk results in chunk order; throws on the first fault.
+template <int D>
+void ExplicitSolver<D>::finish(std::vector<ChunkStats>& stats, bool moved, bool stressed) {
+  const ParticleView<D> p = view<D>(particles_);
+  double internal = 0, dt_min = std::numeric_limits<double>::infinity();
+  double kinetic = 0, work = 0;
+  Vec3 momentum = Vec3::Zero();
+  long off_bin = 0, strays = 0;
+  bool out_of_window = false;
+  for (auto& s : stats) {
+    if (s.fault >= 0) throw InstabilityError(steps_ + 1, time_ + dt_, p.id[s.fault], s.cause);
+    internal += s.internal;
+    dt_min = std::min(dt_min, s.dt_min);
+    kinetic += s.kinetic;
+    work += s.work;
+    momentum += s.momentum;
+    off_bin += s.off_bin;
+    strays += s.strays;
+    out_of_window = out_of_window || s.out_of_window;
+    for (auto i : s.exits) {
+      if (scene_.solver.on_exit == OnExit::Stop) {
+        char where[160];
+        std::snprintf(where, sizeof where, "left the domain at (%.4g, %.4g, %.4g) m",
+                      p.x[i][0], p.x[i][1], D == 3 ? p.x[i][D - 1] : 0.0);
+        throw InstabilityError(steps_ + 1, time_ + dt_, p.id[i],
+                               std::string(where) +
+                                   " (enlarge grid.domain, or set solver.on_exit = \"remove\")");
+      }
+      exits_.push_back(i);
+    }
+  }
+  if (stressed) {
+    balance_.internal = internal;
+    stable_dt_ = std::min(dt_max_, cfl_ * dt_min);
+  }
+  if (moved) {
+    balance_.kinetic = kinetic;
+    balance_.momentum = momentum;
+    balance_.external_work += work;
+    // Re-sort when particles left the window or the domain, or too many left their bins.
+    const double n = double(std::max<std::size_t>(1, p.n));
+    if (out_of_window || !exits_.empty() || strays > 0.01 * n || off_bin > 0.1 * n)
+      need_sort_ = true;
+  }
+}
+
+// ------------------------------------------------------------------------------------------
+// Particle to grid (000, eqs. 1-5): lumped mass, momentum, internal and body forces.
+// Chunks of one colour run in parallel; a particle in its bin's cell adds into registers that
+// are flushed once per cell, one outside its bin's layer (a stray) is done serially at the end.
+
+template <int D>
+template <int F>
+void ExplicitSolver<D>::p2g() {
+  ScopedTimer timer(timers_, timers_.id(F == kForce ? "p2g_force"
+                                        : (F & kForce) ? "p2g"
+                                                       : "p2g_mass_momentum"));
+  constexpr bool kM = F & kMass, kP = F & kMomentum, kF = F & kForce;
+  constexpr int NC = kCorners<D>;
+  if constexpr (kM) grid_.clear(scheme_ == Scheme::MUSL);
+  const ParticleView<D> p = view<D>(particles_);
+  double* m_i = grid_.m.data();
+  Vec<D>* p_i = grid_.v.data();
+  Vec<D>* f_i = grid_.a.data();
+  const auto& bins = binning_.bins();
+  const auto& chunks = binning_.chunks();
+  const int nchunks = binning_.chunk_count();
+  const double inv_h = grid_.inv_h();
+  const Vec<D> b = gravity_;
+
+  // Contribution of particle i (cell fractions xi) to its cell's corners through add(c, ...).
+  auto contribute = [&](std::uint32_t i, const Vec<D>& xi, auto&& add) {
+    double N[NC];
+    Vec<D> G[NC];
+    if constexpr (kF) shape_functions<D>(xi, inv_h, N, G);
+    else shape_values<D>(xi, N);
+    const double m_p = p.m[i];
+    const Vec<D> mv_p = m_p * p.v[i];
+    Mat<D> Vsigma = Mat<D>::Zero();  // V_p sigma_p, in-plane part
+    if constexpr (kF) Vsigma = (m_p / p.rho[i]) * to_matrix(p.sigma[i]).template topLeftCorner<D, D>();
+    for (int c = 0; c < NC; ++c) add(c, m_p * N[c], N[c] * mv_p,
+                                     kF ? Vec<D>(m_p * N[c] * b - Vsigma * G[c]) : Vec<D>::Zero());
+  };
+  auto to_grid = [&](std::int64_t key) {
+    return [&, key](int c, double dm, const Vec<D>& dp, const Vec<D>& df) {
+      const std::int64_t n = key + grid_.corner(c);
+      if constexpr (kM) m_i[n] += dm;
+      if constexpr (kP) p_i[n] += dp;
+      if constexpr (kF) f_i[n] += df;
+    };
+  };
+
+#pragma omp parallel
+  {
+    auto& strays = strays_[omp_get_thread_num()];
+    strays.clear();
+    for (int color = 0; color < 2; ++color) {
+#pragma omp for schedule(dynamic, 1)
+      for (int ch = color; ch < nchunks; ch += 2) {
+        for (std::uint32_t bi = chunks[ch].bin_begin; bi < chunks[ch].bin_end; ++bi) {
+          const Bin& bin = bins[bi];
+          const int layer = grid_.layer(bin.key);
+          double m_c[NC] = {};
+          Vec<D> p_c[NC], f_c[NC];
+          for (int c = 0; c < NC; ++c) p_c[c].setZero(), f_c[c].setZero();
+          auto to_cell = [&](int c, double dm, const Vec<D>& dp, const Vec<D>& df) {
+            if constexpr (kM) m_c[c] += dm;
+            if constexpr (kP) p_c[c] += dp;
+            if constexpr (kF) f_c[c] += df;
+          };
+          for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
+            IVec<D> cell;
+            Vec<D> xi;
+            grid_.locate(p.x[i], cell, xi);
+            const std::int64_t key = grid_.key(cell);
+            if (key == bin.key) contribute(i, xi, to_cell);
+            else if (grid_.layer(key) == layer) contribute(i, xi, to_grid(key));
+            else strays.push_back(i);
+          }
+          for (int c = 0; c < NC; ++c) {
+            const std::int64_t n = bin.key + grid_.corner(c);
+            if constexpr (kM) m_i[n] += m_c[c];
+            if constexpr (kP) p_i[n] += p_c[c];
+            if constexpr (kF) f_i[n] += f_c[c];
+          }
+        }
+      }
+    }
+  }
+  // Strays, serially and in particle order.
+  std::vector<std::uint32_t> all;
+  for (auto& s : strays_) all.insert(all.end(), s.begin(), s.end());
+  std::sort(all.begin(), all.end());
+  for (auto i : all) {
+    IVec<D> cell;
+    Vec<D> xi;
+    grid_.locate(p.x[i], cell, xi);
+    contribute(i, xi, to_grid(grid_.key(cell)));
+  }
+}
+
+// ------------------------------------------------------------------------------------------
+// Grid kernels: nodal velocities and accelerations, boundary conditions (000, eq. 6).
+
+template <int D>
+void ExplicitSolver<D>::apply_boundary(std::vector<Vec<D>>& vel, std::vector<Vec<D>>* acc,
+                                       bool record_force) {
+  // Record the force each face carries (before holding the velocities), then hold them.
+  if (record_force) {
+    face_force_.fill(0.0);
+    auto record = [&](std::int64_t n, int face) {
+      const int axis = face / 2;
+      const double sign = (face % 2 == 0) ? -1.0 : 1.0;
+      face_force_[face] += sign * grid_.m[n] * vel[n][axis] / dt_;
+    };
+    for (const auto& f : grid_.fixed_nodes()) record(f.node, f.face);
+    for (const auto& f : grid_.slip_nodes()) record(f.node, f.face);
+  }
+  for (const auto& f : grid_.fixed_nodes()) {
+    vel[f.node].setZero();
+    if (acc) (*acc)[f.node].setZero();
+  }
+  for (const auto& f : grid_.slip_nodes()) {
+    vel[f.node][f.face / 2] = 0.0;
+    if (acc) (*acc)[f.node][f.face / 2] = 0.0;
+  }
+}
+
+template <int D>
+void ExplicitSolver<D>::grid_velocity() {
+  ScopedTimer timer(timers_, timers_.id("grid_velocity"));
+  const std::int64_t n = std::int64_t(grid_.nodes());
+  const double floor = node_mass_floor_;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) {
+    if (grid_.m[i] > floor) grid_.v[i] /= grid_.m[i];
+    else grid_.v[i].setZero();
+  }
+  apply_boundary(grid_.v, nullptr, false);
+}
+
+template <int D>
+void ExplicitSolver<D>::grid_update(bool momentum_in_v) {
+  ScopedTimer timer(timers_, timers_.id("grid_update"));
+  const std::int64_t n = std::int64_t(grid_.nodes());
+  const double floor = node_mass_floor_, dt = dt_;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) {
+    const double m = grid_.m[i];
+    if (m > floor) {
+      const Vec<D> a_i = grid_.a[i] / m;
+      const Vec<D> v_i = momentum_in_v ? Vec<D>(grid_.v[i] / m) : grid_.v[i];
+      grid_.v[i] = v_i + dt * a_i;  // p_i^{k+1} = p_i^k + f_i dt, divided by m_i
+      grid_.a[i] = a_i;
+    } else {
+      grid_.v[i].setZero();
+      grid_.a[i].setZero();
+    }
+  }
+  apply_boundary(grid_.v, &grid_.a, true);
+}
+
+template <int D>
+void ExplicitSolver<D>::grid_remap() {
+  ScopedTimer timer(timers_, timers_.id("grid_remap"));
+  const std::int64_t n = std::int64_t(grid_.nodes());
+  const double floor = node_mass_floor_;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) {
+    if (grid_.m[i] > floor) grid_.v_remap[i] /= grid_.m[i];
+    else grid_.v_remap[i].setZero();
+  }
+  apply_boundary(grid_.v_remap, nullptr, false);
+}
+
+// ------------------------------------------------------------------------------------------
+// Grid to particle: velocity (000, eqs. 8, 10), position when Move (eqs. 7, 9), and for MUSL
+// the remapped momentum m_p v_p back to the grid (eq. 11), a scatter done by colours.
+
+template <int D>
+void ExplicitSolver<D>::track_move(std::uint32_t i, std::int64_t bin_key, ChunkStats& s) const {
+  const Vec<D>& x = particles_.get<Vec<D>>(col::x)[i];
+  if (!x.allFinite()) {
+    if (s.fault < 0) s.fault = i, s.cause = "its position is not finite";
+    return;
+  }
+  IVec<D> cell;
+  Vec<D> xi;
+  grid_.locate(x, cell, xi);
+  if (!grid_.in_domain(cell)) {
+    s.exits.push_back(i);
+  } else if (!grid_.in_window(cell)) {
+    s.out_of_window = true;
+  } else {
+    const std::int64_t key = grid_.key(cell);
+    if (key != bin_key) {
+      ++s.off_bin;
+      if (grid_.layer(key) != grid_.layer(bin_key)) ++s.strays;
+    }
+  }
+}
+
+template <int D>
+template <bool Remap, bool Move>
+void ExplicitSolver<D>::g2p() {
+  ScopedTimer timer(timers_, timers_.id(Remap ? "g2p_remap" : Move ? "g2p_move" : "g2p"));
+  constexpr int NC = kCorners<D>;
+  const ParticleView<D> p = view<D>(particles_);
+  const Vec<D>* a_i = grid_.a.data();
+  const Vec<D>* v_i = grid_.v.data();
+  Vec<D>* q_i = grid_.v_remap.data();
+  const auto& bins = binning_.bins();
+  const auto& chunks = binning_.chunks();
+  const int nchunks = binning_.chunk_count();
+  const double dt = dt_;
+  const Vec<D> b = gravity_;
+  std::vector<ChunkStats> stats(nchunks);
+
+  auto chunk_body = [&](int ch, std::vector<std::uint32_t>& strays) {
+    ChunkStats& s = stats[ch];
+    for (std::uint32_t bi = chunks[ch].bin_begin; bi < chunks[ch].bin_end; ++bi) {
+      const Bin& bin = bins[bi];
+      const int layer = grid_.layer(bin.key);
+      Vec<D> a_c[NC], v_c[NC], q_c[NC];
+      for (int c = 0; c < NC; ++c) {
+        a_c[c] = a_i[bin.key + grid_.corner(c)];
+        if constexpr (Move) v_c[c] = v_i[bin.key + grid_.corner(c)];
+        q_c[c].setZero();
+      }
+      for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
+        IVec<D> cell;
+        Vec<D> xi;
+        grid_.locate(p.x[i], cell, xi);
+        const std::int64_t key = grid_.key(cell);
+        const bool home = key == bin.key;
+        double N[NC];
+        shape_values<D>(xi, N);
+        Vec<D> a_p = Vec<D>::Zero(), vbar = Vec<D>::Zero();
+        for (int c = 0; c < NC; ++c) {
+          a_p += N[c] * (home ? a_c[c] : a_i[key + grid_.corner(c)]);
+          if constexpr (Move) vbar += N[c] * (home ? v_c[c] : v_i[key + grid_.corner(c)]);
+        }
+        p.v[i] += dt * a_p;  // (000, eq. 8)
+        if constexpr (Move) {
+          p.x[i] += dt * vbar;  // (000, eq. 7)
+          s.kinetic += 0.5 * p.m[i] * p.v[i].squaredNorm();
+          for (int a = 0; a < D; ++a) s.momentum[a] += p.m[i] * p.v[i][a];
+          s.work += dt * p.m[i] * b.dot(p.v[i]);
+          track_move(i, bin.key, s);
+        }
+        if constexpr (Remap) {
+          const Vec<D> mv = p.m[i] * p.v[i];
+          if (home) {
+            for (int c = 0; c < NC; ++c) q_c[c] += N[c] * mv;
+          } else if (grid_.layer(key) == layer) {
+            for (int c = 0; c < NC; ++c) q_i[key + grid_.corner(c)] += N[c] * mv;
+          } else {
+            strays.push_back(i);
+          }
+        }
+      }
+      if constexpr (Remap)
+        for (int c = 0; c < NC; ++c) q_i[bin.key + grid_.corner(c)] += q_c[c];
+    }
+  };
+
+#pragma omp parallel
+  {
+    auto& strays = strays_[omp_get_thread_num()];
+    strays.clear();
+    if constexpr (Remap) {
+      for (int color = 0; color < 2; ++color) {
+#pragma omp for schedule(dynamic, 1)
+        for (int ch = color; ch < nchunks; ch += 2) chunk_body(ch, strays);
+      }
+    } else {
+#pragma omp for schedule(dynamic, 1)
+      for (int ch = 0; ch < nchunks; ++ch) chunk_body(ch, strays);
+    }
+  }
+  if constexpr (Remap) {
+    std::vector<std::uint32_t> all;
+    for (auto& s : strays_) all.insert(all.end(), s.begin(), s.end());
+    std::sort(all.begin(), all.end());
+    for (auto i : all) {
+      IVec<D> cell;
+      Vec<D> xi;
+      grid_.locate(p.x[i], cell, xi);
+      double N[NC];
+      shape_values<D>(xi, N);
+      const std::int64_t key = grid_.key(cell);
+      for (int c = 0; c < NC; ++c) q_i[key + grid_.corner(c)] += N[c] * (p.m[i] * p.v[i]);
+    }
+  }
+  finish(stats, Move, false);
+}
+
+// ------------------------------------------------------------------------------------------
+// Stress update (000, eqs. 12-15): velocity gradient from the grid, then the material update
+// once per block of particles of one material. When `move`, positions advance with the grid
+// velocity (000, eqs. 7, 9) in the same pass.
+
+template <int D>
+void ExplicitSolver<D>::update_stress(const std::vector<Vec<D>>& v_grad, bool move) {
+  ScopedTimer timer(timers_, timers_.id(move ? "stress_move" : "stress"));
+  constexpr int NC = kCorners<D>;
+  ParticleView<D> p = view<D>(particles_);
+  const Vec<D>* vg_i = v_grad.data();
+  const Vec<D>* v_i = grid_.v.data();
+  const auto& bins = binning_.bins();
+  const auto& chunks = binning_.chunks();
+  const int nchunks = binning_.chunk_count();
+  const double dt = dt_, inv_h = grid_.inv_h(), h = grid_.h();
+  const Vec<D> b = gravity_;
+  std::vector<ChunkStats> stats(nchunks);
+
+#pragma omp parallel
+  {
+    StressScratch& scr = *scratch_[omp_get_thread_num()];
+#pragma omp for schedule(dynamic, 1)
+    for (int ch = 0; ch < nchunks; ++ch) {
+      ChunkStats& s = stats[ch];
+      std::uint32_t i0 = 0;
+      int k = 0, mat = -1;
+      // Constitutive update of the pending block [i0, i0 + k) of material `mat`.
+      auto flush = [&]() {
+        if (k == 0) return;
+        MaterialBlock blk;
+        blk.n = k;
+        blk.dt = dt;
+        blk.h = h;
+        blk.L = scr.L;
+        blk.m = p.m + i0;
+        blk.sigma = p.sigma + i0;
+        blk.rho = p.rho + i0;
+        blk.e = p.e + i0;
+        blk.eps_p = p.eps_p ? p.eps_p + i0 : nullptr;
+        blk.T = p.T ? p.T + i0 : nullptr;
+        blk.failed = p.failed ? p.failed + i0 : nullptr;
+        blk.c = scr.c;
+        materials_[mat].update(blk, scr.S);
+        for (int j = 0; j < k; ++j) {
+          const std::uint32_t i = i0 + j;
+          s.internal += p.m[i] * p.e[i];
+          s.dt_min = std::min(s.dt_min, h / (scr.c[j] + p.v[i].norm()));
+        }
+        if (blk.fault_index >= 0 && s.fault < 0) {
+          s.fault = i0 + blk.fault_index;
+          s.cause = blk.fault == PointFault::VolumeInverted
+                        ? "its volume became non-positive (1 + tr(D) dt <= 0)"
+                        : "its stress or energy is not finite";
+        }
+        k = 0;
+      };
+      for (std::uint32_t bi = chunks[ch].bin_begin; bi < chunks[ch].bin_end; ++bi) {
+        const Bin& bin = bins[bi];
+        Vec<D> vg_c[NC], v_c[NC];
+        for (int c = 0; c < NC; ++c) {
+          vg_c[c] = vg_i[bin.key + grid_.corner(c)];
+          if (move) v_c[c] = v_i[bin.key + grid_.corner(c)];
+        }
+        for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
+          IVec<D> cell;
+          Vec<D> xi;
+          grid_.locate(p.x[i], cell, xi);
+          const std::int64_t key = grid_.key(cell);
+          const bool home = key == bin.key;
+          double N[NC];
+          Vec<D> G[NC];
+          shape_functions<D>(xi, inv_h, N, G);
+          // Velocity gradient L = sum_i v_i (x) G_ip (000, eqs. 12-13 use its parts).
+          Mat<D> L = Mat<D>::Zero();
+          Vec<D> vbar = Vec<D>::Zero();
+          for (int c = 0; c < NC; ++c) {
+            const Vec<D>& vg = home ? vg_c[c] : vg_i[key + grid_.corner(c)];
+            L.noalias() += vg * G[c].transpose();
+            if (move) vbar += N[c] * (home ? v_c[c] : v_i[key + grid_.corner(c)]);
+          }
+          if (int(p.material[i]) != mat || k == kBlock) {
+            flush();
+            mat = p.material[i];
+            i0 = i;
+          }
+          scr.L[k].setZero();
+          scr.L[k].template topLeftCorner<D, D>() = L;
+          ++k;
+          if (move) {
+            p.x[i] += dt * vbar;  // (000, eq. 7)
+            s.kinetic += 0.5 * p.m[i] * p.v[i].squaredNorm();
+            for (int a = 0; a < D; ++a) s.momentum[a] += p.m[i] * p.v[i][a];
+            s.work += dt * p.m[i] * b.dot(p.v[i]);
+            track_move(i, bin.key, s);
+          }
+        }
+      }
+      flush();
+    }
+  }
+  finish(stats, move, true);
+}
+
+template class ExplicitSolver<2>;
+template class ExplicitSolver<3>;
+
+}  // namespace mpm

@@ -1,0 +1,132 @@
+#include "mpm/grid.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+
+namespace mpm {
+
+template <int D>
+Grid<D>::Grid(const Lattice& lattice, const BoundarySpec& boundary)
+    : lattice_(lattice), boundary_(boundary), h_(lattice.h), inv_h_(1.0 / lattice.h) {
+  if (lattice.dim != D) throw std::logic_error("lattice dimension does not match the solver");
+  for (int a = 0; a < D; ++a) {
+    origin_[a] = lattice.origin[a];
+    cells_[a] = lattice.cells[a];
+    lo_[a] = 0;
+    hi_[a] = cells_[a] - 1;
+  }
+}
+
+template <int D>
+void Grid<D>::fit(const Vec<D>* x, std::size_t n, int margin) {
+  // Bounding box of the particles' cells (a parallel min/max).
+  IVec<D> lo = cells_, hi = IVec<D>::Constant(-1);
+#pragma omp parallel
+  {
+    IVec<D> tlo = cells_, thi = IVec<D>::Constant(-1);
+#pragma omp for schedule(static) nowait
+    for (std::size_t i = 0; i < n; ++i) {
+      IVec<D> c;
+      Vec<D> xi;
+      locate(x[i], c, xi);
+      tlo = tlo.cwiseMin(c);
+      thi = thi.cwiseMax(c);
+    }
+#pragma omp critical
+    {
+      lo = lo.cwiseMin(tlo);
+      hi = hi.cwiseMax(thi);
+    }
+  }
+  if (n == 0) lo.setZero(), hi.setZero();
+  for (int a = 0; a < D; ++a) {
+    lo_[a] = std::max(0, lo[a] - margin);
+    hi_[a] = std::min(cells_[a] - 1, hi[a] + margin);
+    nodes_[a] = hi_[a] - lo_[a] + 2;
+  }
+  // Slab axis: the longest extent (ties go to the highest axis). It is the slowest index of
+  // the node layout and of the particle order, so a slab of layers is a contiguous range.
+  slab_ = D - 1;
+  for (int a = D - 2; a >= 0; --a)
+    if (nodes_[a] > nodes_[slab_]) slab_ = a;
+  std::int64_t s = 1;
+  for (int a = 0; a < D; ++a)
+    if (a != slab_) stride_[a] = s, s *= nodes_[a];
+  stride_[slab_] = s;
+  s *= nodes_[slab_];
+  if (s > std::int64_t(std::numeric_limits<std::uint32_t>::max()))
+    throw std::runtime_error("grid window of " + std::to_string(s) +
+                             " nodes exceeds 2^32; use larger cells");
+  for (int c = 0; c < kCorners<D>; ++c) {
+    std::int64_t off = 0;
+    for (int a = 0; a < D; ++a)
+      if ((c >> a) & 1) off += stride_[a];
+    corner_[c] = off;
+  }
+  m.resize(s);
+  v.resize(s);
+  a.resize(s);
+  if (!v_remap.empty()) v_remap.resize(s);
+
+  // Nodes on constrained domain faces that the window reaches.
+  fixed_.clear();
+  slip_.clear();
+  for (int face = 0; face < 2 * D; ++face) {
+    const BoundaryType type = boundary_.face[face];
+    if (type == BoundaryType::Free) continue;
+    const int axis = face / 2;
+    const int plane = (face % 2 == 0) ? 0 : cells_[axis];  // global node index of the face
+    const int local = plane - lo_[axis];
+    if (local < 0 || local >= nodes_[axis]) continue;
+    // Enumerate the window's nodes in that plane.
+    IVec<D> k = IVec<D>::Zero();
+    k[axis] = local;
+    const int other0 = axis == 0 ? 1 : 0;
+    const int other1 = D == 3 ? (axis == 2 ? 1 : 2) : -1;
+    const int n0 = nodes_[other0], n1 = other1 >= 0 ? nodes_[other1] : 1;
+    for (int j = 0; j < n1; ++j)
+      for (int i = 0; i < n0; ++i) {
+        k[other0] = i;
+        if (other1 >= 0) k[other1] = j;
+        std::int64_t idx = 0;
+        for (int b = 0; b < D; ++b) idx += std::int64_t(k[b]) * stride_[b];
+        (type == BoundaryType::Fixed ? fixed_ : slip_).push_back({idx, face});
+      }
+  }
+}
+
+template <int D>
+IVec<D> Grid<D>::global_node(std::int64_t index) const {
+  IVec<D> k;
+  for (int a = 0; a < D; ++a) k[a] = int((index / stride_[a]) % nodes_[a]) + lo_[a];
+  return k;
+}
+
+template <int D>
+void Grid<D>::clear(bool remap) {
+  const std::int64_t n = std::int64_t(m.size());
+  if (remap && v_remap.size() != m.size()) v_remap.resize(m.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) {
+    m[i] = 0;
+    v[i].setZero();
+    a[i].setZero();
+    if (remap) v_remap[i].setZero();
+  }
+}
+
+template <int D>
+void Grid<D>::clear_remap() {
+  const std::int64_t n = std::int64_t(m.size());
+  if (v_remap.size() != m.size()) v_remap.resize(m.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) v_remap[i].setZero();
+}
+
+template class Grid<2>;
+template class Grid<3>;
+
+}  // namespace mpm

@@ -1,0 +1,108 @@
+#pragma once
+/// The background grid. The lattice spans the whole domain, but node arrays exist only in a
+/// window around the particles, refitted whenever particles are re-sorted (000, section 4.3:
+/// the grid follows the material). Boundary conditions sit on the domain's faces and are
+/// applied to the window's nodes that lie on those faces, so the window changes nothing of
+/// the result: a node outside the window has no mass and no influence.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "mpm/lattice.hpp"
+#include "mpm/scene.hpp"
+#include "mpm/shape.hpp"
+#include "mpm/types.hpp"
+
+namespace mpm {
+
+template <int D>
+class Grid {
+ public:
+  Grid(const Lattice& lattice, const BoundarySpec& boundary);
+
+  /// Fits the window to the cells of n particles (their bounding box widened by `margin`
+  /// cells, clamped to the domain), chooses the slab axis (the longest), and sizes the node
+  /// arrays. Particles must be inside the domain.
+  void fit(const Vec<D>* x, std::size_t n, int margin = 1);
+
+  // Geometry -------------------------------------------------------------------------------
+  double h() const { return h_; }
+  double inv_h() const { return inv_h_; }
+  const Vec<D>& origin() const { return origin_; }
+  const Lattice& lattice() const { return lattice_; }
+  /// Global cell of a position and the position within it (fractions of h in [0,1)).
+  void locate(const Vec<D>& x, IVec<D>& cell, Vec<D>& xi) const {
+    const Vec<D> r = (x - origin_) * inv_h_;
+    for (int a = 0; a < D; ++a) {
+      const double f = std::floor(r[a]);
+      cell[a] = int(f);
+      xi[a] = r[a] - f;
+    }
+  }
+  /// True when a global cell lies inside the domain.
+  bool in_domain(const IVec<D>& cell) const {
+    for (int a = 0; a < D; ++a)
+      if (cell[a] < 0 || cell[a] >= cells_[a]) return false;
+    return true;
+  }
+  /// True when a global cell lies inside the window.
+  bool in_window(const IVec<D>& cell) const {
+    for (int a = 0; a < D; ++a)
+      if (cell[a] < lo_[a] || cell[a] > hi_[a]) return false;
+    return true;
+  }
+  /// Index of the lower corner node of a window cell; also the cell's sort key.
+  std::int64_t key(const IVec<D>& cell) const {
+    std::int64_t k = 0;
+    for (int a = 0; a < D; ++a) k += std::int64_t(cell[a] - lo_[a]) * stride_[a];
+    return k;
+  }
+  /// Slab layer (position along the slab axis within the window) of a key.
+  int layer(std::int64_t key) const { return int(key / stride_[slab_]); }
+  int layers() const { return hi_[slab_] - lo_[slab_] + 1; }
+  int slab_axis() const { return slab_; }
+  /// Offset of corner c of a cell from its lower corner node.
+  std::int64_t corner(int c) const { return corner_[c]; }
+  std::size_t nodes() const { return m.size(); }
+  /// Global node index (lattice numbering) of a window node.
+  IVec<D> global_node(std::int64_t index) const;
+
+  // Node data (structure of arrays) ---------------------------------------------------------
+  // Scatter kernels accumulate momentum into v, force into a and remapped momentum into
+  // v_remap; the grid kernels then divide by the mass, so after them these hold velocity
+  // (m/s) and acceleration (m/s^2).
+  std::vector<double> m;        ///< nodal mass, kg
+  std::vector<Vec<D>> v;        ///< momentum, then velocity
+  std::vector<Vec<D>> a;        ///< force, then acceleration
+  std::vector<Vec<D>> v_remap;  ///< MUSL: remapped momentum, then velocity
+  /// Clears m, v and a (and v_remap when `remap`) over the window.
+  void clear(bool remap);
+  void clear_remap();
+
+  // Boundary conditions --------------------------------------------------------------------
+  /// A window node on a constrained face; face = 2 * axis + (0 for min, 1 for max).
+  struct FaceNode {
+    std::int64_t node;
+    int face;
+  };
+  /// Nodes on fixed faces (every velocity component held at zero).
+  const std::vector<FaceNode>& fixed_nodes() const { return fixed_; }
+  /// Nodes on slip faces (the normal component held at zero).
+  const std::vector<FaceNode>& slip_nodes() const { return slip_; }
+  const BoundarySpec& boundary() const { return boundary_; }
+
+ private:
+  Lattice lattice_;
+  BoundarySpec boundary_;
+  Vec<D> origin_;
+  double h_, inv_h_;
+  IVec<D> cells_;          ///< domain cells per axis
+  IVec<D> lo_, hi_;        ///< window cells (inclusive)
+  IVec<D> nodes_;          ///< window nodes per axis
+  std::array<std::int64_t, D> stride_{};
+  std::array<std::int64_t, kCorners<D>> corner_{};
+  int slab_ = D - 1;
+  std::vector<FaceNode> fixed_, slip_;
+};
+
+}  // namespace mpm

@@ -1,0 +1,85 @@
+#include "mpm/particles.hpp"
+
+#include "mpm/error.hpp"
+
+namespace mpm {
+
+ColumnNeeds column_needs(const Scene& scene) {
+  ColumnNeeds need;
+  for (const auto& mat : scene.materials) {
+    if (mat.strength.model != StrengthModel::Elastic) need.eps_p = true;
+    if (mat.strength.thermal()) need.T = true;
+    if (mat.failure.enabled()) need.failed = need.eps_p = true;
+  }
+  return need;
+}
+
+namespace {
+void require(const ColumnStore& cols, const std::string& name, ScalarType type, int comps) {
+  const Column* c = cols.find(name);
+  if (!c) throw InputError("model", "particle column '" + name + "' is missing");
+  if (c->info().type != type || c->info().components != comps)
+    throw InputError("model", "particle column '" + name + "' holds " +
+                                  std::to_string(c->info().components) + " x " +
+                                  scalar_name(c->info().type) + ", expected " +
+                                  std::to_string(comps) + " x " + scalar_name(type));
+}
+void ensure(ColumnStore& cols, const ColumnInfo& info) {
+  if (cols.find(info.name)) {
+    require(cols, info.name, info.type, info.components);
+    return;
+  }
+  cols.add(info);
+}
+}  // namespace
+
+void prepare_columns(ColumnStore& cols, const Scene& scene) {
+  const int d = scene.dimension;
+  require(cols, col::x, ScalarType::F64, d);
+  require(cols, col::v, ScalarType::F64, d);
+  require(cols, col::m, ScalarType::F64, 1);
+  require(cols, col::rho, ScalarType::F64, 1);
+  require(cols, col::id, ScalarType::U32, 1);
+  require(cols, col::material, ScalarType::U8, 1);
+  require(cols, col::body, ScalarType::U8, 1);
+  const auto* mat = cols.get<std::uint8_t>(col::material);
+  for (std::size_t i = 0; i < cols.size(); ++i)
+    if (mat[i] >= scene.materials.size())
+      throw InputError("model", "particle " + std::to_string(i) + " refers to material " +
+                                    std::to_string(mat[i]) + " but the scene has " +
+                                    std::to_string(scene.materials.size()));
+  ensure(cols, {col::sigma, ScalarType::F64, 6, "Pa"});
+  ensure(cols, {col::e, ScalarType::F64, 1, "J/kg"});
+  const ColumnNeeds need = column_needs(scene);
+  if (need.eps_p) ensure(cols, {col::eps_p, ScalarType::F64, 1, "-"});
+  if (need.failed) ensure(cols, {col::failed, ScalarType::U8, 1, "-"});
+  if (need.T && !cols.has(col::T)) {
+    cols.add({col::T, ScalarType::F64, 1, "K"});
+    double* T = cols.get<double>(col::T);
+    for (std::size_t i = 0; i < cols.size(); ++i)
+      T[i] = scene.materials[mat[i]].strength.room_temperature;
+  }
+}
+
+template <int D>
+ParticleView<D> view(ColumnStore& cols) {
+  ParticleView<D> p;
+  p.n = cols.size();
+  p.x = cols.get<Vec<D>>(col::x);
+  p.v = cols.get<Vec<D>>(col::v);
+  p.m = cols.get<double>(col::m);
+  p.rho = cols.get<double>(col::rho);
+  p.sigma = cols.get<Sym>(col::sigma);
+  p.e = cols.get<double>(col::e);
+  p.eps_p = cols.get<double>(col::eps_p);
+  p.T = cols.get<double>(col::T);
+  p.failed = cols.get<std::uint8_t>(col::failed);
+  p.id = cols.get<std::uint32_t>(col::id);
+  p.material = cols.get<std::uint8_t>(col::material);
+  p.body = cols.get<std::uint8_t>(col::body);
+  return p;
+}
+template ParticleView<2> view<2>(ColumnStore&);
+template ParticleView<3> view<3>(ColumnStore&);
+
+}  // namespace mpm

@@ -1,0 +1,148 @@
+#include "mpm/prep.hpp"
+
+#include <omp.h>
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "mpm/error.hpp"
+#include "mpm/lattice.hpp"
+#include "mpm/materials/material.hpp"
+#include "mpm/particles.hpp"
+#include "mpm/stream.hpp"
+#include "mpm/version.hpp"
+#include "mpm/voxelise.hpp"
+
+namespace mpm {
+
+namespace {
+
+/// The scene text with grid.domain set to the lattice's (SI numbers) and no padding, so that
+/// mpm-run and mpm-post rebuild the same lattice without the bodies' geometry.
+std::string with_explicit_domain(const std::string& text, const Lattice& lat) {
+  toml::table doc = toml::parse(text);
+  toml::table* grid = doc["grid"].as_table();
+  if (!grid) grid = doc.insert_or_assign("grid", toml::table{}).first->second.as_table();
+  grid->erase("padding");
+  const Vec3 hi = lat.max();
+  toml::array lo_a, hi_a;
+  for (int a = 0; a < lat.dim; ++a) {
+    lo_a.push_back(lat.origin[a]);
+    hi_a.push_back(hi[a]);
+  }
+  grid->insert_or_assign("domain", toml::table{{"min", lo_a}, {"max", hi_a}});
+  std::ostringstream o;
+  o << doc;
+  return o.str() + "\n";
+}
+
+std::string mm(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", x * 1e3);
+  return b;
+}
+
+}  // namespace
+
+int prepare_model(const PrepOptions& opt) {
+  const double t0 = omp_get_wtime();
+  Scene scene = load_scene(opt.scene, opt.overrides);
+  const Lattice lattice = make_lattice(scene);
+  std::vector<BodyReport> report;
+  ColumnStore cols = voxelise(scene, lattice, report);
+  const std::string text = with_explicit_domain(scene.toml, lattice);
+
+  // Estimates: first stable step, steps to the end, memory of a run.
+  double speed = 0;
+  {
+    std::vector<double> c(scene.materials.size());
+    for (std::size_t k = 0; k < c.size(); ++k)
+      c[k] = Material(scene.materials[k], scene.solver).reference_wave_speed();
+    const auto* mat = cols.get<std::uint8_t>(col::material);
+    const double* v = cols.get<double>(col::v);
+    const int d = scene.dimension;
+    for (std::size_t i = 0; i < cols.size(); ++i) {
+      double s2 = 0;
+      for (int a = 0; a < d; ++a) s2 += v[i * d + a] * v[i * d + a];
+      speed = std::max(speed, c[mat[i]] + std::sqrt(s2));
+    }
+  }
+  const double dt = std::min(scene.solver.dt_max, scene.solver.cfl * lattice.h / speed);
+  const double steps = std::ceil(scene.solver.end_time / dt);
+  const ColumnNeeds need = column_needs(scene);
+  const int d = scene.dimension;
+  const double bytes_particle = 2 * d * 8 + 3 * 8 + 48 + 4 + 1 + 1 + (need.eps_p ? 8 : 0) +
+                                (need.T ? 8 : 0) + (need.failed ? 1 : 0);
+  // Grid window around the bodies: cells of the particles' bounding box, 8 + 3 d 8 bytes a node.
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  {
+    const double* x = cols.get<double>(col::x);
+    for (std::size_t i = 0; i < cols.size(); ++i)
+      for (int a = 0; a < d; ++a) lo[a] = std::min(lo[a], x[i * d + a]), hi[a] = std::max(hi[a], x[i * d + a]);
+  }
+  double nodes = 1;
+  for (int a = 0; a < d; ++a) nodes *= std::floor((hi[a] - lo[a]) / lattice.h) + 4;
+  const double bytes_grid = nodes * (8 + 3 * d * 8);
+
+  if (!opt.quiet) {
+    std::fprintf(stderr, "mpm-prep: %s%s%s (%dD%s)\n", scene.source.c_str(),
+                 scene.title.empty() ? "" : ": ", scene.title.c_str(), d,
+                 d == 2 ? ", plane strain, masses per metre" : "");
+    std::fprintf(stderr, "  grid: cell %s mm, domain [%s, %s] x [%s, %s]", mm(lattice.h).c_str(),
+                 mm(lattice.origin[0]).c_str(), mm(lattice.max()[0]).c_str(),
+                 mm(lattice.origin[1]).c_str(), mm(lattice.max()[1]).c_str());
+    if (d == 3)
+      std::fprintf(stderr, " x [%s, %s]", mm(lattice.origin[2]).c_str(), mm(lattice.max()[2]).c_str());
+    std::fprintf(stderr, " mm, %d x %d", lattice.cells[0], lattice.cells[1]);
+    if (d == 3) std::fprintf(stderr, " x %d", lattice.cells[2]);
+    std::fprintf(stderr, " cells\n");
+    std::fprintf(stderr, "  %-14s %-12s %12s %10s %14s %14s %8s\n", "body", "material", "particles",
+                 "spacing", "mass kg", "exact kg", "error");
+    std::size_t total = 0;
+    for (std::size_t b = 0; b < report.size(); ++b) {
+      const BodyReport& r = report[b];
+      total += r.particles;
+      std::fprintf(stderr, "  %-14s %-12s %12zu %7s mm %14.6g %14.6g %7.2f%%\n", r.name.c_str(),
+                   scene.materials[scene.bodies[b].material].name.c_str(), r.particles,
+                   mm(r.spacing).c_str(), r.mass, r.exact_mass,
+                   r.exact_mass > 0 ? 100.0 * (r.mass - r.exact_mass) / r.exact_mass : 0.0);
+      if (r.skipped_overlap > 0)
+        std::fprintf(stderr, "  (body '%s': %zu points inside earlier bodies were not created)\n",
+                     r.name.c_str(), r.skipped_overlap);
+    }
+    std::fprintf(stderr, "  %-14s %-12s %12zu\n", "total", "", total);
+    std::fprintf(stderr,
+                 "  time step: about %.4g ns (cfl %g, fastest signal c + |v| = %.0f m/s), about "
+                 "%.0f steps to %.4g us\n",
+                 dt * 1e9, scene.solver.cfl, speed, steps, scene.solver.end_time * 1e6);
+    std::fprintf(stderr,
+                 "  memory of a run: about %.0f bytes a particle, %.1f MB for particles and %.1f "
+                 "MB for the grid window; %.3g million particle-steps\n",
+                 bytes_particle, bytes_particle * double(total) / 1e6, bytes_grid / 1e6,
+                 double(total) * steps / 1e6);
+    if (scene.solver.cfl > 1.0)
+      std::fprintf(stderr, "  warning: solver.cfl = %g exceeds 1; explicit MPM is then unstable\n",
+                   scene.solver.cfl);
+  }
+
+  StreamWriter out(opt.output);
+  out.write_text(RecordType::Scene, text);
+  std::ostringstream info;
+  info << "tool = \"mpm-prep\"\nversion = \"" << kVersion << "\"\nseconds = "
+       << omp_get_wtime() - t0 << "\n";
+  for (std::size_t b = 0; b < report.size(); ++b)
+    info << "[[bodies]]\nname = \"" << report[b].name << "\"\nparticles = " << report[b].particles
+         << "\nspacing = " << report[b].spacing << "\nmass = " << report[b].mass
+         << "\nexact_mass = " << report[b].exact_mass << "\n";
+  out.write_text(RecordType::Info, info.str());
+  Frame frame;
+  frame.flags = kFrameModel;
+  frame.columns = std::move(cols);
+  out.write_frame(frame);
+  out.write_end(0, "model");
+  return kExitOk;
+}
+
+}  // namespace mpm

@@ -1,0 +1,247 @@
+#include "mpm/run.hpp"
+
+#include <omp.h>
+
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <sstream>
+
+#include "mpm/error.hpp"
+#include "mpm/explicit_solver.hpp"
+#include "mpm/lattice.hpp"
+#include "mpm/stream.hpp"
+#include "mpm/version.hpp"
+
+namespace mpm {
+
+const char* face_name(int face) {
+  static const char* names[6] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
+  return names[face];
+}
+
+namespace {
+
+std::atomic<int> g_signal{0};
+extern "C" void on_signal(int sig) { g_signal = sig; }
+
+/// The model as read from mpm-prep's stream.
+struct Model {
+  std::string scene_text;
+  Frame frame;
+};
+
+Model read_model(const std::string& path) {
+  Model model;
+  bool have_scene = false, have_frame = false;
+  StreamVisitor v;
+  v.scene = [&](const std::string& text) {
+    model.scene_text = text;
+    have_scene = true;
+  };
+  v.frame = [&](Frame&& f) {
+    if (!have_frame) model.frame = std::move(f), have_frame = true;
+  };
+  const StreamSummary s = read_stream(path, v);
+  const std::string name = path == "-" ? "stdin" : path;
+  if (!s.damage.empty()) throw StreamError(name, s.damage);
+  if (!have_scene) throw StreamError(name, "the stream holds no scene record: not a model from mpm-prep");
+  if (!have_frame) throw StreamError(name, "the stream holds no particle frame: not a model from mpm-prep");
+  if (s.ended && s.end_status != 0)
+    throw StreamError(name, "the model was not completed by its producer (status " +
+                                std::to_string(s.end_status) + ": " + s.end_message + ")");
+  return model;
+}
+
+/// History rows, written as HIST records at each frame and every few thousand rows.
+class History {
+ public:
+  History(int dim, const BoundarySpec& bc) : dim_(dim) {
+    add("step", "-");
+    add("time", "s");
+    add("dt", "s");
+    add("kinetic", "J");
+    add("internal", "J");
+    add("external_work", "J");
+    add("removed", "J");
+    add("total", "J");
+    const char* axes[3] = {"momentum_x", "momentum_y", "momentum_z"};
+    for (int a = 0; a < dim; ++a) add(axes[a], "kg m/s");
+    add("particles", "-");
+    for (int f = 0; f < 2 * dim; ++f)
+      if (bc.face[f] != BoundaryType::Free) {
+        faces_.push_back(f);
+        add(std::string("force_") + face_name(f), "N");
+      }
+  }
+  template <class Solver>
+  void record(const Solver& s, double dt) {
+    const Balance& b = s.balance();
+    std::vector<double> row = {double(s.steps()), s.time(), dt, b.kinetic, b.internal,
+                               b.external_work, b.removed, b.total()};
+    for (int a = 0; a < dim_; ++a) row.push_back(b.momentum[a]);
+    row.push_back(double(const_cast<Solver&>(s).particles().size()));
+    for (int f : faces_) row.push_back(s.face_force()[f]);
+    block_.values.insert(block_.values.end(), row.begin(), row.end());
+  }
+  void flush(StreamWriter& w) {
+    if (block_.rows() == 0) return;
+    w.write_history(block_);
+    block_.values.clear();
+  }
+  std::size_t pending() const { return block_.rows(); }
+
+ private:
+  void add(const std::string& name, const std::string& unit) {
+    block_.names.push_back(name);
+    block_.units.push_back(unit);
+  }
+  int dim_;
+  std::vector<int> faces_;
+  HistoryBlock block_;
+};
+
+std::string run_info(const Scene& scene, const Lattice& lat, int threads) {
+  std::ostringstream o;
+  o << "tool = \"mpm-run\"\nversion = \"" << kVersion << "\"\nthreads = " << threads
+    << "\ndimension = " << scene.dimension << "\n[lattice]\norigin = [" << lat.origin[0] << ", "
+    << lat.origin[1] << ", " << lat.origin[2] << "]\nh = " << lat.h << "\ncells = ["
+    << lat.cells[0] << ", " << lat.cells[1] << ", " << lat.cells[2] << "]\n";
+  return o.str();
+}
+
+template <int D>
+int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame& model) {
+  const int threads = omp_get_max_threads();
+  ExplicitSolver<D> solver(scene, lattice, model.columns);
+  StreamWriter out(opt.output);
+  out.write_text(RecordType::Scene, scene.toml);
+  out.write_text(RecordType::Info, run_info(scene, lattice, threads));
+
+  const OutputSpec& o = scene.output;
+  const double end = scene.solver.end_time;
+  KernelTimers& timers = solver.timers();
+  const int t_output = timers.id("output");
+
+  History history(D, scene.boundary);
+  auto emit_frame = [&](std::uint32_t flags) {
+    ScopedTimer timer(timers, t_output);
+    history.flush(out);
+    Frame f;
+    f.step = solver.steps();
+    f.time = solver.time();
+    f.flags = flags;
+    std::swap(f.columns, solver.particles());
+    try {
+      out.write_frame(f, o.fields, o.precision);
+    } catch (...) {
+      std::swap(f.columns, solver.particles());
+      throw;
+    }
+    std::swap(f.columns, solver.particles());
+  };
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  history.record(solver, 0.0);
+  emit_frame(0);
+
+  Progress progress(opt.progress, end);
+  int frame = 1;
+  double next_frame = end * frame / o.frames;
+  double next_history = o.history_interval;
+  int status = kExitOk;
+  std::string message;
+  const long max_steps = scene.solver.max_steps;
+  try {
+    while (solver.time() < end * (1 - 1e-12)) {
+      if (g_signal) {
+        status = 128 + g_signal;
+        message = "interrupted by signal " + std::to_string(int(g_signal)) + " at t = " +
+                  std::to_string(solver.time()) + " s; the last frame is the state then";
+        break;
+      }
+      if (max_steps > 0 && solver.steps() >= max_steps) {
+        message = "stopped at solver.max_steps = " + std::to_string(max_steps);
+        break;
+      }
+      // Land exactly on frame times; avoid a sliver step just before one.
+      double dt = solver.stable_dt();
+      const double to_frame = next_frame - solver.time();
+      if (dt >= to_frame) dt = to_frame;
+      else if (dt > 0.5 * to_frame) dt = 0.5 * to_frame;
+      if (!(dt > 0) || !std::isfinite(dt))
+        throw InstabilityError(solver.steps(), solver.time(), -1,
+                               "the stable time step is " + std::to_string(dt) + " s");
+      solver.step(dt);
+      if (solver.time() >= next_history * (1 - 1e-12) || o.history_interval <= 0) {
+        history.record(solver, dt);
+        next_history += o.history_interval;
+        if (history.pending() >= 4096) history.flush(out);
+      }
+      if (solver.time() >= next_frame * (1 - 1e-12)) {
+        if (history.pending() == 0 || o.history_interval > 0) history.record(solver, dt);
+        emit_frame(frame == o.frames ? kFrameFinal : 0);
+        ++frame;
+        next_frame = frame <= o.frames ? end * frame / o.frames : end;
+      }
+      progress.update(solver.time(), solver.steps());
+    }
+    progress.done(solver.time(), solver.steps());
+    if (status != kExitOk || !message.empty()) {
+      history.record(solver, 0.0);
+      emit_frame(kFrameFinal);
+    }
+    if (message.empty())
+      message = "completed " + std::to_string(solver.steps()) + " steps to t = " +
+                std::to_string(solver.time()) + " s";
+  } catch (const InstabilityError& e) {
+    progress.done(solver.time(), solver.steps());
+    status = kExitUnstable;
+    message = e.what();
+  }
+  history.flush(out);
+  out.write_end(status, message);
+  if (status == kExitUnstable) {
+    std::fprintf(stderr,
+                 "mpm-run: error: %s\nmpm-run: the %d frame(s) written before stay valid "
+                 "(last at t = %g s)\n",
+                 message.c_str(), frame, frame > 1 ? end * (frame - 1) / o.frames : 0.0);
+  } else {
+    std::fprintf(stderr, "mpm-run: %s\n", message.c_str());
+  }
+  if (solver.removed_particles() > 0)
+    std::fprintf(stderr, "mpm-run: %zu particles left the domain and were removed\n",
+                 solver.removed_particles());
+  if (opt.stats) {
+    const double ps = solver.particle_steps();
+    const double wall = timers.total();
+    std::fprintf(stderr, "\n%s", timers.table(ps).c_str());
+    std::fprintf(stderr,
+                 "\nthreads %d, particles %zu, steps %ld, sorts %ld, particle-steps %.4g, "
+                 "%.3f million particle-steps/s\n",
+                 threads, solver.particles().size(), solver.steps(), solver.binning().sorts(), ps,
+                 wall > 0 ? ps / wall / 1e6 : 0.0);
+  }
+  return status;
+}
+
+}  // namespace
+
+int run_model(const RunOptions& opt) {
+  if (opt.threads > 0) omp_set_num_threads(opt.threads);
+  for (const auto& kv : opt.overrides)
+    if (kv.rfind("bodies", 0) == 0)
+      throw InputError("--set " + kv.substr(0, kv.find('=')),
+                       "bodies are fixed once mpm-prep has made the particles; pass this "
+                       "override to mpm-prep instead");
+  Model model = read_model(opt.input);
+  const std::string name = (opt.input == "-" ? std::string("stdin") : opt.input) + " (scene)";
+  const Scene scene = parse_scene(model.scene_text, name, "", opt.overrides);
+  const Lattice lattice = make_lattice(scene);
+  if (scene.dimension == 3) return run<3>(opt, scene, lattice, model.frame);
+  return run<2>(opt, scene, lattice, model.frame);
+}
+
+}  // namespace mpm

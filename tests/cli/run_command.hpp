@@ -1,0 +1,49 @@
+#pragma once
+// Runs a shell command for the CLI tests, capturing its exit status, stdout and stderr.
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace mpm::testing {
+
+struct Result {
+  int status = -1;
+  std::string out, err;
+};
+
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+/// A fresh temporary directory for one test.
+inline std::filesystem::path temp_dir(const std::string& name) {
+  auto d = std::filesystem::path(MPM_BINARY_DIR) / "tmp" / name;
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+/// Runs `cmd` with bash (pipefail on), stdout and stderr to files in `dir`.
+inline Result run(const std::string& cmd, const std::filesystem::path& dir) {
+  const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string full = "bash -o pipefail -c '" + cmd + "' >" + out.string() + " 2>" + err.string() + " </dev/null";
+  const int rc = std::system(full.c_str());
+  Result r;
+  r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+inline const std::string prep = MPM_PREP;
+inline const std::string runner = MPM_RUN;
+inline const std::string post = MPM_POST;
+
+}  // namespace mpm::testing

@@ -1,0 +1,178 @@
+// The command line: help, version, exit statuses, and every kind of bad input gets a clear
+// message naming the file, line or key, and exit status 2 (never a crash).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include "run_command.hpp"
+
+namespace mpm {
+namespace {
+
+using namespace mpm::testing;
+namespace fs = std::filesystem;
+
+const fs::path kBlock = fs::path(MPM_TEST_DATA) / "cli" / "block.toml";
+
+/// Writes the base scene with `from` replaced by `to` (must occur) into dir/name.
+fs::path variant(const fs::path& dir, const std::string& name, const std::string& from,
+                 const std::string& to) {
+  std::string text = slurp(kBlock);
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  const fs::path p = dir / name;
+  std::ofstream(p) << text;
+  return p;
+}
+
+TEST(Cli, HelpAndVersion) {
+  const auto dir = temp_dir("help");
+  for (const auto& tool : {prep, runner, post}) {
+    Result r = run(tool + " --help", dir);
+    EXPECT_EQ(r.status, 0) << tool;
+    EXPECT_NE(r.out.find("Exit status"), std::string::npos) << tool << r.out;
+    r = run(tool + " --version", dir);
+    EXPECT_EQ(r.status, 0);
+    EXPECT_TRUE(std::regex_search(r.out, std::regex("mpm-(prep|run|post) [0-9]+\\.[0-9]+\\.[0-9]+")))
+        << r.out;
+    r = run(tool + " --no-such-option", dir);
+    EXPECT_EQ(r.status, 2) << tool;
+  }
+  for (const char* sub : {"summary", "history", "vtk", "taylor", "render"}) {
+    Result r = run(post + " " + sub + " --help", dir);
+    EXPECT_EQ(r.status, 0) << sub;
+  }
+  EXPECT_EQ(run(post, dir).status, 2);  // a subcommand is required
+}
+
+TEST(Cli, PipelineRunsAndReports) {
+  const auto dir = temp_dir("pipeline");
+  Result r = run(prep + " " + kBlock.string() + " | " + runner + " --progress none | " + post +
+                     " summary -",
+                 dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("frames: 5"), std::string::npos) << r.out;  // initial + 4
+  EXPECT_NE(r.out.find("status 0"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("block"), std::string::npos);  // the prep summary names the body
+}
+
+struct BadScene {
+  const char* name;
+  const char* from;
+  const char* to;
+  std::vector<std::string> expect;  // fragments the message must contain
+};
+
+TEST(Cli, BadScenesAreReportedWithFileLineAndKey) {
+  const auto dir = temp_dir("bad_scenes");
+  const std::vector<BadScene> cases = {
+      {"malformed.toml", "cfl = 0.5", "cfl = = 0.5", {"malformed.toml:", "TOML"}},
+      {"unknown_key.toml", "cfl = 0.5", "cfl = 0.5\nclf = 0.4", {"unknown_key.toml:", "clf"}},
+      {"unknown_nested.toml", "B = \"100 MPa\"", "B = \"100 MPa\"\nbogus = 1", {"bogus"}},
+      {"unknown_material.toml", "material = \"steel\"", "material = \"stele\"", {"stele", "steel"}},
+      {"negative_density.toml", "\"7800 kg/m^3\"", "\"-7800 kg/m^3\"", {"density"}},
+      {"poisson.toml", "poisson_ratio = 0.3", "poisson_ratio = 0.5", {"poisson_ratio", "0.5"}},
+      {"poisson2.toml", "poisson_ratio = 0.3", "poisson_ratio = 0.62", {"poisson_ratio"}},
+      {"wrong_unit.toml", "\"200 GPa\"", "\"200 m/s\"", {"youngs_modulus", "velocity"}},
+      {"no_particles.toml", "translate = \"0 0 2 mm\"", "translate = \"0 0 50 mm\"", {"block"}},
+      {"open_mesh.toml", "shape = \"box\"\nsize = \"4 4 4 mm\"",
+       "shape = \"mesh\"\nfile = \"open.off\"", {"open.off", "closed"}},
+      {"missing_mesh.toml", "shape = \"box\"\nsize = \"4 4 4 mm\"",
+       "shape = \"mesh\"\nfile = \"nowhere.stl\"", {"nowhere.stl"}},
+  };
+  // An open mesh: a cube without its top face.
+  std::ofstream(dir / "open.off") << "OFF\n8 5 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+                                     "4 0 3 2 1\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n";
+  for (const auto& c : cases) {
+    const fs::path scene = variant(dir, c.name, c.from, c.to);
+    Result r = run(prep + " " + scene.string() + " -o " + (dir / "model.mpm").string(), dir);
+    EXPECT_EQ(r.status, 2) << c.name << "\n" << r.err;
+    EXPECT_NE(r.err.find("error"), std::string::npos) << c.name;
+    for (const auto& frag : c.expect) EXPECT_NE(r.err.find(frag), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_EQ(r.err.find("internal error"), std::string::npos) << c.name;
+  }
+  // A line number: the unknown key sits on a known line of the file.
+  const fs::path scene = variant(dir, "line.toml", "cfl = 0.5", "cfl = 0.5\nclf = 0.4");
+  std::string text = slurp(scene);
+  const int line = 1 + int(std::count(text.begin(), text.begin() + text.find("clf"), '\n'));
+  Result r = run(prep + " " + scene.string() + " -o /dev/null", dir);
+  EXPECT_NE(r.err.find("line.toml:" + std::to_string(line)), std::string::npos) << r.err;
+  // Missing scene file, bad --set.
+  EXPECT_EQ(run(prep + " /no/such/scene.toml -o /dev/null", dir).status, 2);
+  r = run(prep + " " + kBlock.string() + " --set solver.cfl=abc -o /dev/null", dir);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("solver.cfl"), std::string::npos) << r.err;
+  r = run(prep + " " + kBlock.string() + " --set nonsense -o /dev/null", dir);
+  EXPECT_EQ(r.status, 2);
+}
+
+TEST(Cli, DamagedStreamsKeepTheFramesBefore) {
+  const auto dir = temp_dir("damaged");
+  const fs::path out = dir / "run.mpm";
+  Result r = run(prep + " " + kBlock.string() + " | " + runner + " --progress none -o " + out.string(), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string bytes = slurp(out);
+  ASSERT_GT(bytes.size(), 1000u);
+  // Truncated in the middle of the last frame.
+  {
+    std::ofstream(dir / "cut.mpm", std::ios::binary) << bytes.substr(0, bytes.size() * 9 / 10);
+    r = run(post + " summary " + (dir / "cut.mpm").string(), dir);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("truncated"), std::string::npos) << r.err;
+    EXPECT_NE(r.out.find("frames: 4"), std::string::npos) << r.out;  // the 4 before the cut
+    r = run(post + " taylor " + (dir / "cut.mpm").string() + " --axis z --wall 0", dir);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.out.find("L = "), std::string::npos) << "measured on the frames before";
+    EXPECT_NE(r.err.find("used the 4 frame"), std::string::npos) << r.err;
+  }
+  // Corrupted: one byte flipped in the middle.
+  {
+    std::string bad = bytes;
+    bad[bad.size() * 3 / 4] ^= 0x5A;
+    std::ofstream(dir / "flip.mpm", std::ios::binary) << bad;
+    r = run(post + " summary " + (dir / "flip.mpm").string(), dir);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("corrupt"), std::string::npos) << r.err;
+  }
+  // mpm-run refuses a damaged model, a scene file and an empty input.
+  r = run(prep + " " + kBlock.string() + " -o " + (dir / "model.mpm").string(), dir);
+  ASSERT_EQ(r.status, 0);
+  const std::string model = slurp(dir / "model.mpm");
+  std::ofstream(dir / "model_cut.mpm", std::ios::binary) << model.substr(0, model.size() / 2);
+  r = run(runner + " " + (dir / "model_cut.mpm").string() + " -o /dev/null", dir);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("truncated"), std::string::npos) << r.err;
+  r = run(runner + " " + kBlock.string() + " -o /dev/null", dir);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("scene file"), std::string::npos) << r.err;
+  r = run(runner + " /dev/null -o /dev/null", dir);
+  EXPECT_EQ(r.status, 2);
+  // Overrides of the geometry belong to mpm-prep.
+  r = run(runner + " " + (dir / "model.mpm").string() + " --set bodies.block.velocity=1 -o /dev/null", dir);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("mpm-prep"), std::string::npos);
+}
+
+// A run that goes unstable (CFL far above 1) stops with exit status 3, names the step, the
+// particle and the cause, and the frames it wrote before stay readable.
+TEST(Cli, UnstableRunStopsAndKeepsItsFrames) {
+  const auto dir = temp_dir("unstable");
+  const fs::path out = dir / "run.mpm";
+  Result r = run(prep + " " + kBlock.string() +
+                     " --set solver.cfl=6 --set output.frames=40 --set solver.end_time=\"40 us\" | " +
+                     runner + " --progress none -o " + out.string(),
+                 dir);
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("unstable at step"), std::string::npos) << r.err;
+  r = run(post + " summary " + out.string(), dir);
+  EXPECT_EQ(r.status, 0) << r.err;  // the stream is intact, with an end record saying why
+  EXPECT_NE(r.out.find("status 3"), std::string::npos) << r.out;
+  r = run(post + " history " + out.string() + " -o " + (dir / "h.csv").string(), dir);
+  EXPECT_EQ(r.status, 3);  // the run's failure propagates to scripts
+}
+
+}  // namespace
+}  // namespace mpm
