@@ -56,30 +56,43 @@ struct HistoryBlock {
 /// reader at the other end of a pipe sees frames as they come.
 class StreamWriter {
  public:
+  /// Opens the file (or takes stdout for "-") and writes the 16-byte header; throws IoError.
   explicit StreamWriter(const std::string& path);
+  /// Closes the file (errors are ignored here; call close() to see them). stdout stays open.
   ~StreamWriter();
   StreamWriter(const StreamWriter&) = delete;
   StreamWriter& operator=(const StreamWriter&) = delete;
 
+  /// Writes a SCEN or INFO record holding UTF-8 text.
   void write_text(RecordType type, const std::string& text);
   /// Writes the columns named in `fields` (all when empty; unknown names throw InputError).
   /// Float32 precision stores f64 columns as f32, except "x" (positions keep f64).
   void write_frame(const Frame& frame, const std::vector<std::string>& fields = {},
                    Precision precision = Precision::Float64);
+  /// Writes a HIST record (names and units must have the same size, values a multiple of it).
   void write_history(const HistoryBlock& block);
+  /// Writes the ENDS record: status 0 for a completed run, non-zero with a message otherwise.
   void write_end(int status, const std::string& message);
+  /// Flushes and closes the file (stdout is flushed, not closed); throws IoError on failure.
+  /// Later writes throw, as do writes after a failed one. The destructor closes silently.
+  void close();
+  /// Bytes written so far, header included.
   std::uint64_t bytes_written() const { return offset_; }
+  /// The path given to the constructor ("-" for stdout).
   const std::string& path() const { return path_; }
 
  private:
   void begin_record(RecordType type, std::uint64_t length);
   void put(const void* data, std::size_t n);  ///< writes and updates the running CRC
   void end_record();
+  [[noreturn]] void fail_io(int err);  ///< throws IoError naming the path and strerror
   std::string path_;
   std::FILE* f_ = nullptr;
   bool owns_ = false;
   std::uint64_t offset_ = 0;
   std::uint32_t crc_ = 0;
+  std::uint64_t remaining_ = 0;  ///< payload bytes still due in the current record
+  bool broken_ = false;          ///< a write failed: later writes throw (no record after a cut one)
 };
 
 /// Reads a stream sequentially from a file or stdin ("-").
@@ -98,28 +111,46 @@ class StreamReader {
     std::vector<std::byte> payload;  ///< empty for frames read through read_frame()
   };
 
-  /// Reads the next record's type; false at the end of the stream. Must be followed by
-  /// read_payload(), read_frame() or skip(). Throws StreamError on a truncated header.
+  /// Reads the next record's type; false at the end of the stream (EOF at a record boundary).
+  /// Should be followed by read_payload(), read_frame() or skip() (a record left unread is
+  /// skipped). Throws StreamError on a truncated record header, an implausible length or a
+  /// type code that is not four characters [A-Z0-9_]. After a StreamError, every call
+  /// throws it again.
   bool next(std::uint32_t& type);
   /// The payload of the current record (checked against its CRC).
   std::vector<std::byte> read_payload();
   /// The current record as a frame (must be a FRAM record), decoded straight into columns;
   /// f32 columns are widened to f64. Checked against its CRC.
   Frame read_frame();
-  /// Skips the current record (still checks its CRC).
+  /// Skips the current record (still checks its CRC), reading in chunks (works on pipes).
   void skip();
 
-  /// Decoders for payloads.
+  /// Decoders for payloads; a malformed payload throws StreamError (where is empty).
   static std::string decode_text(const std::vector<std::byte>& payload);
   static HistoryBlock decode_history(const std::vector<std::byte>& payload);
   static std::pair<int, std::string> decode_end(const std::vector<std::byte>& payload);
 
+  /// The path given to the constructor ("-" for stdin).
   const std::string& path() const { return path_; }
+  /// Bytes consumed so far, header included.
   std::uint64_t offset() const { return offset_; }
+  /// Byte offset of the current (last announced) record.
+  std::uint64_t record_offset() const { return record_offset_; }
+  /// Records passed intact (CRC checked).
   std::size_t records_read() const { return records_; }
+  /// FRAM records passed intact, whether decoded or skipped.
   std::size_t frames_read() const { return frames_; }
+  /// "record 7 (FRAM at byte 123456)" for the current record, for messages.
+  std::string record_label() const;
+  /// "the 3 frames before it are intact", for messages.
+  std::string intact_label() const;
 
  private:
+  void read_exact(void* data, std::size_t n);  ///< payload bytes; updates the CRC
+  void finish_record();                        ///< reads and checks the CRC
+  [[noreturn]] void fail(const std::string& message);
+  [[noreturn]] void fail_truncated(const std::string& expected, std::uint64_t found);
+  [[noreturn]] void fail_corrupt(const std::string& why);
   std::string path_;
   std::FILE* f_ = nullptr;
   bool owns_ = false;
@@ -129,10 +160,14 @@ class StreamReader {
   std::uint64_t length_ = 0;
   bool pending_ = false;
   std::size_t records_ = 0, frames_ = 0;
+  std::uint32_t crc_ = 0;       ///< running CRC of the current record
+  std::uint64_t done_ = 0;      ///< payload bytes of the current record read so far
+  std::string damage_;          ///< what() of the first StreamError, rethrown afterwards
 };
 
 /// Everything in a stream, delivered record by record. Every callback may be empty.
 struct StreamVisitor {
+  /// Callbacks per record type: SCEN text, INFO text, frames, history blocks, ENDS.
   std::function<void(const std::string&)> scene;
   std::function<void(const std::string&)> info;
   std::function<void(Frame&&)> frame;
@@ -143,7 +178,7 @@ struct StreamVisitor {
 
 /// Result of reading a whole stream.
 struct StreamSummary {
-  std::size_t frames = 0;
+  std::size_t frames = 0;      ///< intact frames (delivered, or skipped when !want_frames)
   bool ended = false;          ///< an END record was seen
   int end_status = 0;
   std::string end_message;
