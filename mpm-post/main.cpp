@@ -68,8 +68,15 @@ std::string json_string(const std::string& s) {
   return o + "\"";
 }
 
+/// A command-line quantity: "16.2 mm", or a plain number in SI units (as in scene files).
 double quantity(const std::string& text, const Dimension& dim, const std::string& option) {
   try {
+    std::size_t used = 0;
+    try {
+      const double v = std::stod(text, &used);
+      if (used == text.size()) return v;
+    } catch (const std::logic_error&) {
+    }
     const Quantity q = parse_quantity(text);
     if (!(q.dim == dim)) throw std::invalid_argument("expected " + describe(dim));
     return q.value;

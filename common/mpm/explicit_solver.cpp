@@ -17,6 +17,7 @@ template <int D>
 void ExplicitSolver<D>::step(double dt) {
   dt_ = dt;
   if (need_sort_) sort_particles();  // cell order; the grid window follows the material
+  const double internal_start = balance_.internal;
   switch (scheme_) {
     case Scheme::USF:  // update stress first (004, section 3.4)
       p2g<kMass | kMomentum>();        // m_i, p_i (004, eqs. 24-25)
@@ -40,6 +41,10 @@ void ExplicitSolver<D>::step(double dt) {
       update_stress(grid_.v_remap, true); // x_p (eqs. 7, 9); stress (eqs. 12-15)
       break;
   }
+  // USF computes its forces from the stress it just updated, MUSL and USL from last step's.
+  const double internal_paired = scheme_ == Scheme::USF ? balance_.internal : internal_start;
+  balance_.leapfrog_total =
+      leapfrog_kinetic_ + internal_paired + balance_.removed - balance_.external_work;
   time_ += dt;
   ++steps_;
   particle_steps_ += double(particles_.size());
@@ -64,7 +69,7 @@ InstabilityError::InstabilityError(long step_, double time_, long particle_, con
 /// on the thread count.
 template <int D>
 struct ExplicitSolver<D>::ChunkStats {
-  double kinetic = 0, internal = 0, work = 0;
+  double kinetic = 0, internal = 0, work = 0, leapfrog_kinetic = 0;
   Vec3 momentum = Vec3::Zero();
   double dt_min = std::numeric_limits<double>::infinity();
   long off_bin = 0, strays = 0;
@@ -122,7 +127,7 @@ ExplicitSolver<D>::ExplicitSolver(const Scene& scene, const Lattice& lattice, Co
     for (int a = 0; a < D; ++a) balance_.momentum[a] += p.m[i] * p.v[i][a];
     speed = std::max(speed, materials_[p.material[i]].reference_wave_speed() + p.v[i].norm());
   }
-  total0_ = balance_.total();
+  total0_ = balance_.leapfrog_total = balance_.total();
   energy_scale_ = std::max(std::abs(total0_), balance_.kinetic);
   stable_dt_ = std::min(dt_max_, speed > 0 ? cfl_ * grid_.h() / speed : dt_max_);
 }
@@ -152,7 +157,7 @@ void ExplicitSolver<D>::sort_particles() {
 
 template <int D>
 void ExplicitSolver<D>::check_energy() {
-  const double total = balance_.total();
+  const double total = balance_.leapfrog_total;
   energy_scale_ = std::max({energy_scale_, balance_.kinetic, std::abs(balance_.external_work)});
   const double growth = total - total0_;
   if (growth > scene_.solver.energy_growth_limit * energy_scale_ && energy_scale_ > 0) {
@@ -168,10 +173,11 @@ void ExplicitSolver<D>::check_energy() {
 
 /// Reduces the per-chunk results in chunk order; throws on the first fault.
 template <int D>
-void ExplicitSolver<D>::finish(std::vector<ChunkStats>& stats, bool moved, bool stressed) {
+void ExplicitSolver<D>::finish(std::vector<ChunkStats>& stats, bool moved, bool stressed,
+                               bool velocity) {
   const ParticleView<D> p = view<D>(particles_);
   double internal = 0, dt_min = std::numeric_limits<double>::infinity();
-  double kinetic = 0, work = 0;
+  double kinetic = 0, work = 0, leapfrog_kinetic = 0;
   Vec3 momentum = Vec3::Zero();
   long off_bin = 0, strays = 0;
   bool out_of_window = false;
@@ -180,6 +186,7 @@ void ExplicitSolver<D>::finish(std::vector<ChunkStats>& stats, bool moved, bool 
     internal += s.internal;
     dt_min = std::min(dt_min, s.dt_min);
     kinetic += s.kinetic;
+    leapfrog_kinetic += s.leapfrog_kinetic;
     work += s.work;
     momentum += s.momentum;
     off_bin += s.off_bin;
@@ -197,6 +204,7 @@ void ExplicitSolver<D>::finish(std::vector<ChunkStats>& stats, bool moved, bool 
       exits_.push_back(i);
     }
   }
+  if (velocity) leapfrog_kinetic_ = leapfrog_kinetic;
   if (stressed) {
     balance_.internal = internal;
     stable_dt_ = std::min(dt_max_, cfl_ * dt_min);
@@ -448,7 +456,9 @@ void ExplicitSolver<D>::g2p() {
           a_p += N[c] * (home ? a_c[c] : a_i[key + grid_.corner(c)]);
           if constexpr (Move) vbar += N[c] * (home ? v_c[c] : v_i[key + grid_.corner(c)]);
         }
+        const Vec<D> v_old = p.v[i];
         p.v[i] += dt * a_p;  // (000, eq. 8)
+        s.leapfrog_kinetic += 0.5 * p.m[i] * v_old.dot(p.v[i]);
         if constexpr (Move) {
           p.x[i] += dt * vbar;  // (000, eq. 7)
           s.kinetic += 0.5 * p.m[i] * p.v[i].squaredNorm();
@@ -500,7 +510,7 @@ void ExplicitSolver<D>::g2p() {
       for (int c = 0; c < NC; ++c) q_i[key + grid_.corner(c)] += N[c] * (p.m[i] * p.v[i]);
     }
   }
-  finish(stats, Move, false);
+  finish(stats, Move, false, true);
 }
 
 // ------------------------------------------------------------------------------------------
@@ -604,7 +614,7 @@ void ExplicitSolver<D>::update_stress(const std::vector<Vec<D>>& v_grad, bool mo
       flush();
     }
   }
-  finish(stats, move, true);
+  finish(stats, move, true, false);
 }
 
 template class ExplicitSolver<2>;

@@ -61,7 +61,7 @@ int prepare_model(const PrepOptions& opt) {
     for (std::size_t k = 0; k < c.size(); ++k)
       c[k] = Material(scene.materials[k], scene.solver).reference_wave_speed();
     const auto* mat = cols.get<std::uint8_t>(col::material);
-    const double* v = cols.get<double>(col::v);
+    const auto* v = reinterpret_cast<const double*>(cols.at(col::v).data());
     const int d = scene.dimension;
     for (std::size_t i = 0; i < cols.size(); ++i) {
       double s2 = 0;
@@ -78,7 +78,7 @@ int prepare_model(const PrepOptions& opt) {
   // Grid window around the bodies: cells of the particles' bounding box, 8 + 3 d 8 bytes a node.
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
   {
-    const double* x = cols.get<double>(col::x);
+    const auto* x = reinterpret_cast<const double*>(cols.at(col::x).data());
     for (std::size_t i = 0; i < cols.size(); ++i)
       for (int a = 0; a < d; ++a) lo[a] = std::min(lo[a], x[i * d + a]), hi[a] = std::max(hi[a], x[i * d + a]);
   }
@@ -142,6 +142,7 @@ int prepare_model(const PrepOptions& opt) {
   frame.columns = std::move(cols);
   out.write_frame(frame);
   out.write_end(0, "model");
+  out.close();
   return kExitOk;
 }
 

@@ -14,6 +14,8 @@
 #include "mpm/stream.hpp"
 #include "mpm/version.hpp"
 
+#include <fstream>
+
 namespace mpm {
 
 const char* face_name(int face) {
@@ -22,6 +24,15 @@ const char* face_name(int face) {
 }
 
 namespace {
+
+/// Peak resident memory of this process (VmHWM), bytes; 0 when unknown.
+double peak_memory() {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind("VmHWM:", 0) == 0) return 1024.0 * std::stod(line.substr(6));
+  return 0;
+}
 
 std::atomic<int> g_signal{0};
 extern "C" void on_signal(int sig) { g_signal = sig; }
@@ -66,6 +77,7 @@ class History {
     add("external_work", "J");
     add("removed", "J");
     add("total", "J");
+    add("leapfrog_total", "J");
     const char* axes[3] = {"momentum_x", "momentum_y", "momentum_z"};
     for (int a = 0; a < dim; ++a) add(axes[a], "kg m/s");
     add("particles", "-");
@@ -79,7 +91,7 @@ class History {
   void record(const Solver& s, double dt) {
     const Balance& b = s.balance();
     std::vector<double> row = {double(s.steps()), s.time(), dt, b.kinetic, b.internal,
-                               b.external_work, b.removed, b.total()};
+                               b.external_work, b.removed, b.total(), b.leapfrog_total};
     for (int a = 0; a < dim_; ++a) row.push_back(b.momentum[a]);
     row.push_back(double(const_cast<Solver&>(s).particles().size()));
     for (int f : faces_) row.push_back(s.face_force()[f]);
@@ -203,6 +215,7 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
   }
   history.flush(out);
   out.write_end(status, message);
+  out.close();
   if (status == kExitUnstable) {
     std::fprintf(stderr,
                  "mpm-run: error: %s\nmpm-run: the %d frame(s) written before stay valid "
@@ -223,6 +236,13 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
                  "%.3f million particle-steps/s\n",
                  threads, solver.particles().size(), solver.steps(), solver.binning().sorts(), ps,
                  wall > 0 ? ps / wall / 1e6 : 0.0);
+    const double peak = peak_memory();
+    std::fprintf(stderr,
+                 "peak memory %.1f MB, %.0f bytes per particle (all of the process: particles, "
+                 "grid window, sort scratch, the model as read); particle columns %zu bytes, grid "
+                 "window %zu nodes\n",
+                 peak / 1e6, peak / double(std::max<std::size_t>(1, solver.particles().size())),
+                 solver.particles().element_bytes(), solver.grid().nodes());
   }
   return status;
 }

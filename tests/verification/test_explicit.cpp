@@ -71,8 +71,9 @@ TEST(Explicit, ConservesMassAndMomentum2D) {
 }
 
 // A block in uniform translation: no strain, so no stress, and every particle moves by v t.
+// USF and MUSL keep the stress at round-off while the particles cross cells (and are re-sorted).
 TEST(Explicit, UniformTranslationKeepsZeroStress) {
-  for (Scheme scheme : {Scheme::USF, Scheme::USL, Scheme::MUSL}) {
+  for (Scheme scheme : {Scheme::USF, Scheme::MUSL}) {
     const double h = 1e-3;
     Scene s = scene_with(elastic(200e9, 0.3, 7800), 3, h, 1.0);
     s.solver.scheme = scheme;
@@ -81,8 +82,6 @@ TEST(Explicit, UniformTranslationKeepsZeroStress) {
     ColumnStore cols = block<3>(lat, IVec<3>(3, 5, 5), IVec<3>(9, 11, 11), 2, 7800,
                                 [&](const Vec3&) { return v0; });
     const std::vector<Vec3> x0(cols.get<Vec3>(col::x), cols.get<Vec3>(col::x) + cols.size());
-    const std::vector<std::uint32_t> id0(cols.get<std::uint32_t>(col::id),
-                                         cols.get<std::uint32_t>(col::id) + cols.size());
     ExplicitSolver<3> solver(s, lat, cols);
     while (solver.time() < 40e-6) solver.step(solver.stable_dt());  // ~6 mm: crosses cells
     auto p = view<3>(cols);
@@ -95,100 +94,133 @@ TEST(Explicit, UniformTranslationKeepsZeroStress) {
     }
     EXPECT_LT(smax, 1e-3) << "Pa of stress from a pure translation";  // round-off only
     EXPECT_GT(solver.binning().sorts(), 1);  // the particles were re-sorted as they moved
-    (void)id0;
   }
 }
 
-// A block spinning rigidly about its centre, slowly enough that the centripetal stress
-// rho w^2 R^2 is small. The Jaumann rate is objective and the velocity gradient of a rigid
-// spin sampled at interior nodes is exactly antisymmetric, so the stress stays a small
-// fraction of what a strain of w R t / R = w t (the rotation angle) would cause, E w t.
-TEST(Explicit, RigidRotationKeepsStressNearZero) {
-  const double h = 1e-3, E = 200e9, rho = 7800;
+// USL takes its strain rate from grid velocities that include f_i / m_i dt; at a node that a
+// particle barely reaches (m_i ~ m_p xi^3 while f_i ~ V sigma xi^2 / h) that term is not
+// bounded, and round-off stress grows by an order of magnitude a step (the small-mass
+// instability of USL; Bardenhagen 2002, Wallstedt & Guilkey 2008). The run guard must stop it
+// with a message naming the step and the cause instead of running on to NaN.
+TEST(Explicit, UslSmallMassInstabilityIsStoppedByTheEnergyGuard) {
+  const double h = 1e-3;
+  Scene s = scene_with(elastic(200e9, 0.3, 7800), 3, h, 1.0);
+  s.solver.scheme = Scheme::USL;
+  const Lattice lat = lattice(3, Vec3::Zero(), h, {30, 20, 20});
+  const Vec3 v0(150.0, -40.0, 25.0);
+  ColumnStore cols = block<3>(lat, IVec<3>(3, 5, 5), IVec<3>(9, 11, 11), 2, 7800,
+                              [&](const Vec3&) { return v0; });
+  ExplicitSolver<3> solver(s, lat, cols);
+  try {
+    while (solver.time() < 40e-6) solver.step(solver.stable_dt());
+    FAIL() << "USL ran through; if it is now stable here, update docs/scene.md";
+  } catch (const InstabilityError& e) {
+    EXPECT_NE(std::string(e.what()).find("energy"), std::string::npos) << e.what();
+    EXPECT_GT(e.step, 10);
+    auto p = view<3>(cols);
+    for (std::size_t i = 0; i < p.n; ++i) ASSERT_TRUE(p.x[i].allFinite());  // stopped before NaN
+  }
+}
+
+// A block spinning rigidly about its centre. Linear MPM does not sample a rigid spin exactly
+// at the body's boundary nodes (their velocity is that of the particles' mass centre around
+// them), so some stress appears there; it must be small against E theta (what a strain equal
+// to the rotation angle theta would give; a non-objective update gets stress of that order)
+// and vanish at first order in h. Measured: 2.27 MPa at h = 1 mm, 1.12 MPa at 0.5 mm.
+double spin_stress(int refine, double& angular_error) {
+  const double h = 1e-3 / refine, E = 200e9, rho = 7800, w = 200.0;
   Scene s = scene_with(elastic(E, 0.3, rho), 3, h, 1.0);
-  const Lattice lat = lattice(3, Vec3::Zero(), h, {24, 24, 12});
+  const Lattice lat = lattice(3, Vec3::Zero(), h, {24 * refine, 24 * refine, 12 * refine});
   const Vec3 centre(12e-3, 12e-3, 6e-3);
-  const double w = 200.0;  // rad/s
-  ColumnStore cols = block<3>(lat, IVec<3>(7, 7, 3), IVec<3>(17, 17, 9), 2, rho, [&](const Vec3& x) {
-    return Vec3(-w * (x[1] - centre[1]), w * (x[0] - centre[0]), 0.0);
-  });
+  auto spin = [&](const Vec3& x) { return Vec3(-w * (x[1] - centre[1]), w * (x[0] - centre[0]), 0.0); };
+  ColumnStore cols = block<3>(lat, IVec<3>(7, 7, 3) * refine, IVec<3>(17, 17, 9) * refine, 2, rho, spin);
+  auto angular = [&](ColumnStore& c) {
+    auto p = view<3>(c);
+    double Lz = 0;
+    for (std::size_t i = 0; i < p.n; ++i) {
+      const Vec3 r = p.x[i] - centre;
+      Lz += p.m[i] * (r[0] * p.v[i][1] - r[1] * p.v[i][0]);
+    }
+    return Lz;
+  };
+  const double Lz0 = angular(cols);
   ExplicitSolver<3> solver(s, lat, cols);
   const double t_end = 0.02 / w;  // 0.02 rad
   while (solver.time() < t_end) solver.step(std::min(solver.stable_dt(), t_end - solver.time()));
   auto p = view<3>(cols);
   double vm = 0;
   for (std::size_t i = 0; i < p.n; ++i) vm = std::max(vm, von_mises(p.sigma[i]));
-  const double R = 7e-3;
-  const double centripetal = rho * w * w * R * R;  // ~15 kPa
-  const double rotation_strain_stress = E * w * solver.time();  // 4 GPa if the spin were strain
-  EXPECT_LT(vm, 1e-4 * rotation_strain_stress);
-  EXPECT_LT(vm, 50 * centripetal);
-  // Angular momentum about the axis is kept to within the scheme's dissipation.
-  double Lz = 0, Lz0 = 0;
-  for (std::size_t i = 0; i < p.n; ++i) {
-    const Vec3 r = p.x[i] - centre;
-    Lz += p.m[i] * (r[0] * p.v[i][1] - r[1] * p.v[i][0]);
-  }
-  ColumnStore again = block<3>(lat, IVec<3>(7, 7, 3), IVec<3>(17, 17, 9), 2, rho, [&](const Vec3& x) {
-    return Vec3(-w * (x[1] - centre[1]), w * (x[0] - centre[0]), 0.0);
-  });
-  auto q = view<3>(again);
-  for (std::size_t i = 0; i < q.n; ++i) {
-    const Vec3 r = q.x[i] - centre;
-    Lz0 += q.m[i] * (r[0] * q.v[i][1] - r[1] * q.v[i][0]);
-  }
-  EXPECT_NEAR(Lz, Lz0, 0.02 * Lz0);
+  angular_error = std::abs(angular(cols) / Lz0 - 1);
+  return vm / (E * 0.02);
 }
 
-// 1D elastic wave: a bar (one cell square, slip on its sides) moving at v0 hits a fixed wall.
-// A compressive step sigma = rho c v0 runs back at c = sqrt(E/rho) (nu = 0). Check the
-// amplitude behind the front and the front's position (where the stress is half the step).
-TEST(Explicit, ElasticWaveSpeedAndAmplitude) {
-  const double E = 100e9, rho = 5000, h = 0.5e-3, v0 = 10.0;
-  const double c = std::sqrt(E / rho);  // 4472 m/s
-  Scene s = scene_with(elastic(E, 0.0, rho), 3, h, 1.0);
-  s.boundary.face = {BoundaryType::Slip, BoundaryType::Free, BoundaryType::Slip,
-                     BoundaryType::Slip, BoundaryType::Slip, BoundaryType::Slip};
-  s.solver.cfl = 0.5;
-  const int cells = 200;
-  const Lattice lat = lattice(3, Vec3::Zero(), h, {cells + 4, 1, 1});
-  ColumnStore cols = block<3>(lat, IVec<3>(0, 0, 0), IVec<3>(cells, 1, 1), 2, rho,
-                              [&](const Vec3&) { return Vec3(-v0, 0, 0); });
-  ExplicitSolver<3> solver(s, lat, cols);
-  const double t_end = 0.6 * cells * h / c;
-  while (solver.time() < t_end) solver.step(std::min(solver.stable_dt(), t_end - solver.time()));
+TEST(Explicit, RigidRotationStressIsSmallAndConvergesAwayAtFirstOrder) {
+  double a1, a2;
+  const double s1 = spin_stress(1, a1), s2 = spin_stress(2, a2);
+  EXPECT_LT(s1, 1e-3);
+  EXPECT_LT(s2 / s1, 0.6) << "first order: halving h must roughly halve it";
+  EXPECT_LT(a1, 0.02) << "angular momentum";
+  EXPECT_LT(a2, a1 + 1e-3);
+}
+
+// 1D elastic wave: a bar (one cell square, slip on its sides) moving at v0 hits a slip wall.
+// A compressive step sigma = rho c v0 runs back at c = sqrt(E/rho) (nu = 0) relative to the
+// bar ahead of it, c - v0 in the lab. MPM smears the step over a few cells, so the speed is
+// taken from the motion of its half-amplitude point between two times (found from the far
+// side, past the noise behind the front); measured within 0.35% for all schemes at 200 cells.
+double half_point(ColumnStore& cols, double amplitude) {
   auto p = view<3>(cols);
-  const double amplitude = rho * c * v0;  // 224 MPa
-  // Mean stress over particles well behind the front, and the front position.
-  double sum = 0;
-  int count = 0;
-  std::vector<std::pair<double, double>> profile;
-  for (std::size_t i = 0; i < p.n; ++i) profile.emplace_back(p.x[i][0], -p.sigma[i][0]);
-  std::sort(profile.begin(), profile.end());
-  const double front_exact = c * solver.time();  // from the wall, x = 0
-  for (auto& [x, sig] : profile)
-    if (x > 0.2 * front_exact && x < 0.8 * front_exact) sum += sig, ++count;
-  const double mean = sum / count;
-  EXPECT_NEAR(mean, amplitude, 0.02 * amplitude);
-  double front = 0;
-  for (std::size_t k = 1; k < profile.size(); ++k)
-    if (profile[k - 1].second >= 0.5 * amplitude && profile[k].second < 0.5 * amplitude) {
-      front = profile[k].first;
-      break;
-    }
-  // The wall moves nothing, but the bar shortens by v0 t: the front is measured in the
-  // deformed bar, x_front = (c - v0) t from the wall. Tolerance: one cell.
-  EXPECT_NEAR(front, (c - v0) * solver.time(), h);
+  std::vector<std::pair<double, double>> prof;
+  for (std::size_t i = 0; i < p.n; ++i) prof.emplace_back(p.x[i][0], -p.sigma[i][0]);
+  std::sort(prof.begin(), prof.end());
+  for (std::size_t k = prof.size() - 1; k > 0; --k) {
+    const auto [x0, s0] = prof[k - 1];
+    const auto [x1, s1] = prof[k];
+    if (s0 >= 0.5 * amplitude && s1 < 0.5 * amplitude)
+      return x0 + (x1 - x0) * (s0 - 0.5 * amplitude) / (s0 - s1);
+  }
+  return NAN;
+}
+
+TEST(Explicit, ElasticWaveSpeedAndAmplitude) {
+  for (Scheme scheme : {Scheme::USF, Scheme::USL, Scheme::MUSL}) {
+    const double E = 100e9, rho = 5000, h = 0.5e-3, v0 = 10.0;
+    const double c = std::sqrt(E / rho);  // 4472 m/s
+    Scene s = scene_with(elastic(E, 0.0, rho), 3, h, 1.0);
+    s.solver.scheme = scheme;
+    s.boundary.face = {BoundaryType::Slip, BoundaryType::Free, BoundaryType::Slip,
+                       BoundaryType::Slip, BoundaryType::Slip, BoundaryType::Slip};
+    const int cells = 200;
+    const Lattice lat = lattice(3, Vec3::Zero(), h, {cells + 4, 1, 1});
+    ColumnStore cols = block<3>(lat, IVec<3>(0, 0, 0), IVec<3>(cells, 1, 1), 2, rho,
+                                [&](const Vec3&) { return Vec3(-v0, 0, 0); });
+    ExplicitSolver<3> solver(s, lat, cols);
+    const double amplitude = rho * c * v0;  // 224 MPa
+    const double T = cells * h / c, t1 = 0.3 * T, t2 = 0.7 * T;
+    while (solver.time() < t1) solver.step(std::min(solver.stable_dt(), t1 - solver.time()));
+    const double x1 = half_point(cols, amplitude);
+    while (solver.time() < t2) solver.step(std::min(solver.stable_dt(), t2 - solver.time()));
+    const double x2 = half_point(cols, amplitude);
+    EXPECT_NEAR((x2 - x1) / (t2 - t1), c - v0, 0.01 * c) << "scheme " << int(scheme);
+    // Amplitude: mean stress over the middle of the compressed part.
+    auto p = view<3>(cols);
+    double sum = 0;
+    int count = 0;
+    for (std::size_t i = 0; i < p.n; ++i)
+      if (p.x[i][0] > 0.2 * x2 && p.x[i][0] < 0.8 * x2) sum += -p.sigma[i][0], ++count;
+    EXPECT_NEAR(sum / count, amplitude, 0.02 * amplitude) << "scheme " << int(scheme);
+  }
 }
 
 // Energy of an elastic vibration: a bar with fixed ends, initial velocity v0 sin(pi x / L)
-// (the first mode). Kinetic and strain energy trade places; their sum must stay within 1% over
-// two periods at CFL 0.5 (MUSL damps a little; USL would gain energy on this problem).
-TEST(Explicit, ElasticVibrationConservesEnergy) {
-  const double E = 100e9, rho = 5000, h = 1e-3, v0 = 1.0;
-  const int cells = 50;
+// (its first mode). Kinetic and strain energy trade places. Over whole periods the total
+// drifts by less than 0.05% a period (measured 0.014%); within a period it swings by O(dt)
+// because leapfrog velocities live at half steps (1.6% at 50 cells, 0.8% at 100: first order).
+double vibration(Scheme scheme, int cells, double& drift_4_periods) {
+  const double E = 100e9, rho = 5000, v0 = 1.0, h = 0.05 / cells;
   const double Lbar = cells * h, c = std::sqrt(E / rho);
   Scene s = scene_with(elastic(E, 0.0, rho), 3, h, 1.0);
+  s.solver.scheme = scheme;
   s.boundary.face = {BoundaryType::Fixed, BoundaryType::Fixed, BoundaryType::Slip,
                      BoundaryType::Slip, BoundaryType::Slip, BoundaryType::Slip};
   const Lattice lat = lattice(3, Vec3::Zero(), h, {cells, 1, 1});
@@ -198,17 +230,26 @@ TEST(Explicit, ElasticVibrationConservesEnergy) {
   ExplicitSolver<3> solver(s, lat, cols);
   const double E0 = solver.balance().total();
   const double period = 2 * Lbar / c;
-  double kmin = 1e300, kmax = 0, emax_err = 0;
-  while (solver.time() < 2 * period) {
-    solver.step(std::min(solver.stable_dt(), 2 * period - solver.time()));
-    const Balance& b = solver.balance();
-    kmin = std::min(kmin, b.kinetic);
-    kmax = std::max(kmax, b.kinetic);
-    emax_err = std::max(emax_err, std::abs(b.total() - E0) / E0);
+  double kmin = 1e300, swing = 0;
+  while (solver.time() < 4 * period) {
+    solver.step(std::min(solver.stable_dt(), 4 * period - solver.time()));
+    kmin = std::min(kmin, solver.balance().kinetic);
+    swing = std::max(swing, std::abs(solver.balance().total() / E0 - 1));
   }
-  EXPECT_LT(kmin, 0.05 * E0);  // it does vibrate: kinetic energy goes (almost) to zero
-  EXPECT_GT(kmax, 0.95 * E0);
-  EXPECT_LT(emax_err, 0.01);
+  EXPECT_LT(kmin, 0.05 * E0) << "it vibrates: kinetic energy goes (almost) to zero";
+  drift_4_periods = std::abs(solver.balance().total() / E0 - 1);
+  return swing;
+}
+
+TEST(Explicit, ElasticVibrationConservesEnergy) {
+  for (Scheme scheme : {Scheme::USF, Scheme::MUSL}) {
+    double d50, d100;
+    const double s50 = vibration(scheme, 50, d50), s100 = vibration(scheme, 100, d100);
+    EXPECT_LT(d50, 4 * 0.0005) << "secular drift over 4 periods";
+    EXPECT_LT(d100, 4 * 0.0005);
+    EXPECT_LT(s50, 0.02);
+    EXPECT_LT(s100 / s50, 0.6) << "the swing is first order in dt";
+  }
 }
 
 }  // namespace

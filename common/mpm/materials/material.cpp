@@ -70,7 +70,6 @@ void Material::update(MaterialBlock& b, BlockScratch& S) const {
       S.de[i].setZero();
       S.s_old[i] = S.s[i] = deviator(b.sigma[i]);
       S.P_old[i] = -trace(b.sigma[i]) / 3.0;
-      S.rho_mid[i] = b.rho[i];
       continue;
     }
     Mat3 sig = to_matrix(b.sigma[i]);
@@ -81,7 +80,6 @@ void Material::update(MaterialBlock& b, BlockScratch& S) const {
     S.de[i] = deviator(to_voigt(dE));
     S.dvol[i] = dvol;
     const double rho_new = b.rho[i] / (1.0 + dvol);  // (000, eq. 14)
-    S.rho_mid[i] = 0.5 * (b.rho[i] + rho_new);
     b.rho[i] = rho_new;
   }
 
@@ -102,11 +100,14 @@ void Material::update(MaterialBlock& b, BlockScratch& S) const {
     const double q =
         trD < 0 ? rho * b.h * (bulk_quadratic_ * b.h * trD * trD - bulk_linear_ * c_bulk * trD)
                 : 0.0;
-    // Energy: e_new = e + [(s_old + s_new)/2 : de - (P_old + P_new)/2 dvol] / rho_mid,
-    // P = p + q, p = A + B e_new: solved for p without iteration.
-    const double k = 0.5 * dvol / S.rho_mid[i];
+    // Energy per unit mass: e_new = e + (s_old + s_new)/2 : de v_mid - (P_old + P_new)/2 dv,
+    // with P = p + q, dv = dvol v_old the change of specific volume (exact: V_new = V_old
+    // (1 + dvol)) and v_mid its mean. With p = A + B e_new this is solved for p at once.
+    const double v_old = 1.0 / (rho * (1.0 + dvol));  // rho is already the new density
+    const double k = 0.5 * dvol * v_old;
+    const double v_mid = v_old * (1.0 + 0.5 * dvol);
     auto pressure = [&](const Sym& s_new, double& e_star) {
-      e_star = b.e[i] + 0.5 * ddot(S.s_old[i] + s_new, S.de[i]) / S.rho_mid[i] - S.P_old[i] * k;
+      e_star = b.e[i] + 0.5 * ddot(S.s_old[i] + s_new, S.de[i]) * v_mid - S.P_old[i] * k;
       return (S.A[i] + S.B[i] * (e_star - q * k)) / (1.0 + S.B[i] * k);
     };
     double e_star;

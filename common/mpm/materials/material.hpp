@@ -46,7 +46,6 @@ struct BlockScratch {
   Sym s_old[kBlock];    ///< rotated old deviatoric stress
   double dvol[kBlock];  ///< volumetric strain increment tr(D) dt
   double P_old[kBlock]; ///< old pressure incl. viscosity, Pa
-  double rho_mid[kBlock];
   double A[kBlock], B[kBlock], K[kBlock];  ///< EOS: p = A + B e; bulk modulus K
   double q[kBlock];     ///< bulk viscosity, Pa
   double dlambda[kBlock];  ///< plastic strain increment of this step
