@@ -28,6 +28,9 @@ inline const std::string T = "T";                ///< f64, temperature, K
 inline const std::string failed = "failed";      ///< u8, 1 once the failure criterion was met
 }  // namespace col
 
+/// Material id of the particles of rigid bodies (they have no material).
+inline constexpr std::uint8_t kRigidMaterial = 255;
+
 /// Raw pointers into the particle columns for the kernels; optional columns are nullptr when
 /// absent. Valid until the columns are resized or reordered.
 template <int D>

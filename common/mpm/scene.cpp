@@ -583,7 +583,7 @@ bool valid_name(std::string_view s) {
 
 const std::vector<std::string_view> kBodyKeys = {
     "name", "material", "shape",  "size",      "radius",   "length",
-    "file", "scale",    "rotate", "translate", "velocity", "particles_per_cell"};
+    "file", "scale",    "rotate", "translate", "velocity", "particles_per_cell", "rigid"};
 
 BodySpec read_body(Reader& r, const Scene& scene) {
   const int n = scene.dimension;
@@ -592,10 +592,16 @@ BodySpec read_body(Reader& r, const Scene& scene) {
   b.name = *r.string("name");
   b.loc = r.loc();
 
+  b.rigid = r.boolean("rigid").value_or(false);
   const auto material = r.string("material");
-  if (!material) r.missing("material", "the name of a material, e.g. \"copper\"");
-  b.material = scene.material_index(*material);
-  if (b.material < 0) {
+  if (b.rigid) {
+    if (material)
+      r.fail("material", "a rigid body has no material (it moves at its velocity whatever happens)");
+  } else if (!material) {
+    r.missing("material", "the name of a material, e.g. \"copper\"");
+  }
+  b.material = material ? scene.material_index(*material) : -1;
+  if (!b.rigid && b.material < 0) {
     std::vector<std::string_view> known;
     for (const auto& m : scene.materials) known.push_back(m.name);
     r.fail("material", "unknown material '" + *material + "' (known: " + join(known) + ")");
@@ -730,6 +736,56 @@ void read_bodies(Reader& top, Scene& s) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Loads
+
+void read_loads(Reader& top, Scene& s) {
+  const toml::node* node = top.get("loads");
+  if (!node) return;
+  const auto* arr = node->as_array();
+  if (!arr) {
+    top.fail("loads", "expected an array of tables ([[loads]], note the double brackets), " + got(*node));
+  }
+  const Doc& doc = top.doc();
+  const Origin array_origin = top.origin_of(*node);
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    const toml::node& e = (*arr)[i];
+    const std::string path = "loads." + std::to_string(i);
+    const Origin o = doc.origin(e, array_origin);
+    const auto* t = e.as_table();
+    if (!t) throw InputError(doc.where(o, path), "expected a table ([[loads]]), " + got(e));
+    Reader r(doc, *t, path, o, {"body", "force", "region"});
+    LoadSpec l;
+    l.loc = r.loc();
+    const auto body = r.string("body");
+    if (!body) r.missing("body", "the name of the body the force acts on, e.g. \"rod\"");
+    l.body = s.body_index(*body);
+    if (l.body < 0) {
+      std::vector<std::string_view> known;
+      for (const auto& b : s.bodies) known.push_back(b.name);
+      r.fail("body", "unknown body '" + *body + "' (known: " + join(known) + ")");
+    }
+    if (s.bodies[l.body].rigid) r.fail("body", "a rigid body cannot carry a load");
+    const auto f = r.vector("force", dim::force, s.dimension);
+    if (!f) r.missing("force", s.dimension == 2 ? "the total force, e.g. \"2.5 0 N\"" : "the total force, e.g. \"2.5 0 0 N\"");
+    l.force = *f;
+    if (auto reg = r.table("region", {"min", "max"})) {
+      const auto lo = reg->vector("min", dim::length, s.dimension);
+      const auto hi = reg->vector("max", dim::length, s.dimension);
+      if (!lo) reg->missing("min", "the region's minimum corner");
+      if (!hi) reg->missing("max", "the region's maximum corner");
+      for (int a = 0; a < s.dimension; ++a)
+        reg->check("max", (*hi)[a] > (*lo)[a], "must exceed region.min in every component");
+      l.region_given = true;
+      l.region_min = *lo;
+      l.region_max = *hi;
+      reg->finish();
+    }
+    r.finish();
+    s.loads.push_back(l);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
 // Grid, boundary, solver, output
 
 void read_grid(Reader& r, Scene& s) {
@@ -844,12 +900,17 @@ void read_output(Reader& r, Scene& s) {
 
 void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
   Reader top(doc, root, "", Origin{},
-             {"scene", "materials", "bodies", "grid", "boundary", "solver", "output"});
-  if (auto t = top.table("scene", {"title", "dimension"})) {
+             {"scene", "materials", "bodies", "loads", "grid", "boundary", "solver", "output"});
+  if (auto t = top.table("scene", {"title", "dimension", "geometry"})) {
     s.title = t->string("title").value_or("");
     if (auto d = t->integer("dimension")) {
-      t->check("dimension", *d == 2 || *d == 3, "must be 3, or 2 (plane strain in the x-y plane)");
+      t->check("dimension", *d == 2 || *d == 3, "must be 3, or 2 (the x-y plane)");
       s.dimension = static_cast<int>(*d);
+    }
+    if (auto g = t->choice<bool>("geometry", {{"plane-strain", false}, {"axisymmetric", true}})) {
+      if (s.dimension != 2)
+        t->fail("geometry", "is for 2D scenes (dimension = 2): \"plane-strain\" or \"axisymmetric\"");
+      s.axisymmetric = *g;
     }
     t->finish();
   }
@@ -880,6 +941,7 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
   }
 
   read_bodies(top, s);
+  read_loads(top, s);
 
   {
     Reader g =
@@ -899,6 +961,20 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
   }
   if (auto o = top.table("output", {"frames", "history_interval", "fields", "precision"})) {
     read_output(*o, s);
+  }
+  if (s.axisymmetric) {
+    // x is the radius: the domain starts at the axis or beyond, and the axis holds u_r = 0.
+    const SourceLoc& g = s.grid.loc;
+    if (!s.grid.domain_given)
+      throw InputError(where(g.file, g.line, "grid.domain"),
+                       "axisymmetric scenes need grid.domain with min x >= 0 (x is the radius)");
+    if (s.grid.domain_min.x() < 0)
+      throw InputError(where(g.file, g.line, "grid.domain.min"),
+                       "the radius x must be >= 0 in axisymmetric scenes");
+    if (s.grid.domain_min.x() == 0 && s.boundary.face[0] == BoundaryType::Free)
+      throw InputError(where(g.file, g.line, "boundary.x_min"),
+                       "the axis r = 0 is the domain face x_min: set boundary.x_min = \"slip\" "
+                       "(no radial velocity on the axis)");
   }
   top.finish();
 }
@@ -944,22 +1020,28 @@ void apply_override(toml::table& root, const std::string& arg, Doc& doc) {
   toml::table* t = &root;
   std::size_t i = 0;
   std::string walked;
-  if (parts[0] == "bodies" && parts.size() > 1) {
+  if ((parts[0] == "bodies" || parts[0] == "loads") && parts.size() > 1) {
+    const std::string& what = parts[0];
     if (parts.size() < 3) {
-      throw InputError(loc, "expected bodies.<name or index>.<key>, e.g. bodies.bar.velocity");
+      throw InputError(loc, what == "bodies"
+                                ? "expected bodies.<name or index>.<key>, e.g. bodies.bar.velocity"
+                                : "expected loads.<index>.<key>, e.g. loads.0.force");
     }
-    auto* arr = root.get_as<toml::array>("bodies");
-    if (!arr) throw InputError(loc, "the scene has no [[bodies]] to change");
+    auto* arr = root.get_as<toml::array>(what);
+    if (!arr) throw InputError(loc, "the scene has no [[" + what + "]] to change");
     const std::string& sel = parts[1];
     toml::node* body = nullptr;
     if (std::all_of(sel.begin(), sel.end(), [](char c) { return c >= '0' && c <= '9'; })) {
       std::size_t index = 0;
       const auto [ptr, ec] = std::from_chars(sel.data(), sel.data() + sel.size(), index);
       if (ec != std::errc() || index >= arr->size()) {
-        throw InputError(loc, "no body with index " + sel + " (the scene has " +
+        throw InputError(loc, "no " + std::string(what == "bodies" ? "body" : "load") +
+                                  " with index " + sel + " (the scene has " +
                                   std::to_string(arr->size()) + ", numbered from 0)");
       }
       body = arr->get(index);
+    } else if (what == "loads") {
+      throw InputError(loc, "loads are selected by index, e.g. loads.0.force");
     } else {
       std::vector<std::string> known;
       for (auto& e : *arr) {
@@ -975,9 +1057,9 @@ void apply_override(toml::table& root, const std::string& arg, Doc& doc) {
       }
     }
     t = body->as_table();
-    if (!t) throw InputError(loc, "bodies." + sel + " is not a table");
+    if (!t) throw InputError(loc, what + "." + sel + " is not a table");
     i = 2;
-    walked = "bodies." + sel;
+    walked = what + "." + sel;
   }
   for (; i + 1 < parts.size(); ++i) {
     walked += (walked.empty() ? "" : ".") + parts[i];
@@ -1039,6 +1121,15 @@ std::string to_toml(const toml::table& root) {
 }
 
 }  // namespace
+
+int Scene::body_index(const std::string& name) const {
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (bodies[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+double Scene::measure_factor() const { return axisymmetric ? 2.0 * 3.14159265358979323846 : 1.0; }
 
 int Scene::material_index(const std::string& name) const {
   for (std::size_t i = 0; i < materials.size(); ++i) {

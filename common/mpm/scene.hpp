@@ -85,8 +85,20 @@ struct BodySpec {
   Vec3 scale = Vec3::Ones();     ///< applied first
   Vec3 rotate_deg = Vec3::Zero();///< rotations about x, then y, then z, degrees
   Vec3 translate = Vec3::Zero(); ///< applied last, m
-  Vec3 velocity = Vec3::Zero();  ///< initial velocity, m/s
+  Vec3 velocity = Vec3::Zero();  ///< initial velocity, m/s (rigid bodies: kept for ever)
   int particles_per_cell = 2;    ///< per axis: n x n x n particles in each cell
+  bool rigid = false;            ///< moves at `velocity` whatever happens; no-slip contact
+  SourceLoc loc;
+};
+
+/// A constant force applied from t = 0 to the particles of a body inside a region (all of the
+/// body when no region is given), shared equally among them.
+struct LoadSpec {
+  int body = -1;                   ///< index into Scene::bodies
+  Vec3 force = Vec3::Zero();       ///< total force, N (plane strain: N per metre; axisymmetric: whole ring)
+  bool region_given = false;
+  Vec3 region_min = Vec3::Zero();  ///< m, initial positions
+  Vec3 region_max = Vec3::Zero();
   SourceLoc loc;
 };
 
@@ -136,9 +148,11 @@ struct Scene {
   std::string source;      ///< file name (or "<stream>") the scene was read from
   std::string directory;   ///< directory of the scene file, for relative mesh paths
   std::string title;
-  int dimension = 3;       ///< 3, or 2 (plane strain, x-y plane)
+  int dimension = 3;       ///< 3, or 2 (x-y plane)
+  bool axisymmetric = false;  ///< 2D only: x is the radius, y the axis; else plane strain
   std::vector<MaterialSpec> materials;
   std::vector<BodySpec> bodies;
+  std::vector<LoadSpec> loads;
   GridSpec grid;
   BoundarySpec boundary;
   SolverSpec solver;
@@ -147,6 +161,11 @@ struct Scene {
 
   /// Index of a material by name, -1 if absent.
   int material_index(const std::string& name) const;
+  /// Index of a body by name, -1 if absent.
+  int body_index(const std::string& name) const;
+  /// Factor from the computed quantities (per metre of thickness in plane strain, per radian
+  /// in axisymmetry) to reported totals (whole revolution): 2 pi in axisymmetry, else 1.
+  double measure_factor() const;
 };
 
 /// Parses a scene from TOML text. `source` names it in messages; `directory` resolves relative

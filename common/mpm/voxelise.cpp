@@ -2,6 +2,8 @@
 // Mesh regions (CGAL) live in mesh_region.cpp.
 #include "mpm/voxelise.hpp"
 
+#include "mpm/particles.hpp"
+
 #include <omp.h>
 
 #include <Eigen/Geometry>
@@ -302,6 +304,12 @@ struct BodyPlan {
   double particle_volume = 0, mass = 0;
 };
 
+/// Density of a body's particles; rigid bodies carry a nominal 1 kg/m^3 (their mass is their
+/// volume and takes no part in the dynamics).
+double density_of(const Scene& scene, const BodySpec& body) {
+  return body.rigid ? 1.0 : scene.materials[body.material].density;
+}
+
 }  // namespace
 
 ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyReport>& report) {
@@ -321,12 +329,13 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
   std::vector<Vec3> blo(nb), bhi(nb);
   for (std::size_t b = 0; b < nb; ++b) {
     const BodySpec& body = scene.bodies[b];
-    if (body.material < 0 || body.material >= int(scene.materials.size()) || body.material > 255)
+    if (!body.rigid &&
+        (body.material < 0 || body.material >= int(scene.materials.size()) || body.material > 254))
       throw InputError(body_where(scene, body, "material"),
                        "body '" + body.name + "' has no valid material (index " +
                            std::to_string(body.material) + " of " +
                            std::to_string(scene.materials.size()) + ")");
-    const double rho = scene.materials[body.material].density;
+    const double rho = density_of(scene, body);
     if (!(rho > 0) || !std::isfinite(rho))
       throw InputError(where(scene.source, scene.materials[body.material].loc.line,
                              "materials." + scene.materials[body.material].name + ".density"),
@@ -354,8 +363,8 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
     const double s = h / n;
     P.n = n;
     P.ppc = dim == 3 ? n * n * n : n * n;
-    P.particle_volume = dim == 3 ? s * s * s : s * s * 1.0;  // 2D: 1 m thick
-    P.mass = scene.materials[body.material].density * P.particle_volume;
+    P.particle_volume = dim == 3 ? s * s * s : s * s * 1.0;  // 2D: 1 m thick (or per radian, times r)
+    P.mass = density_of(scene, body) * P.particle_volume;
 
     bool empty = false;
     for (int a = 0; a < 3; ++a) {
@@ -516,9 +525,10 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
     const BodySpec& body = scene.bodies[b];
     const BodyPlan& P = plans[b];
     const int n = P.n, nz = dim == 3 ? n : 1;
-    const double density = scene.materials[body.material].density;
+    const double density = density_of(scene, body);
     const auto body_id = static_cast<std::uint8_t>(b);
-    const auto mat_id = static_cast<std::uint8_t>(body.material);
+    const auto mat_id = static_cast<std::uint8_t>(body.rigid ? kRigidMaterial : body.material);
+    const bool axi = scene.axisymmetric;
 #pragma omp parallel for schedule(dynamic, 8)
     for (long long r = 0; r < P.rows; ++r) {
       const long long iy = r % P.ny, iz = r / P.ny;
@@ -545,7 +555,7 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
           id[k] = static_cast<std::uint32_t>(k);
           bcol[k] = body_id;
           mcol[k] = mat_id;
-          mass[k] = P.mass;
+          mass[k] = axi ? P.mass * x[0] : P.mass;  // axisymmetric: per radian, A r
           rho[k] = density;
           ++k;
         }
@@ -556,8 +566,16 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
     BodyReport rep;
     rep.name = body.name;
     rep.particles = P.kept;
-    rep.mass = double(P.kept) * P.mass;
+    rep.mass = 0;
+    for (std::size_t k = base - P.kept; k < base; ++k) rep.mass += mass[k];
     rep.exact_mass = density * regions[b]->volume();  // 2D: area x 1 m
+    if (axi) {
+      // Per radian: area times the radius of its centroid (Pappus); the shapes allowed in 2D
+      // (boxes, disks) have their centroid at the centre of their bounding box.
+      Vec3 lo, hi;
+      regions[b]->bounds(lo, hi);
+      rep.exact_mass *= 0.5 * (lo.x() + hi.x());
+    }
     rep.spacing = h / n;
     rep.skipped_overlap = P.skipped;
     report.push_back(rep);

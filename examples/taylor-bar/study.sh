@@ -19,7 +19,7 @@ for cell in "$@"; do
   end=$(date +%s.%N)
   c=$("$bin/mpm-post/mpm-post" taylor "$out" --json)
   s=$("$bin/mpm-post/mpm-post" taylor "$out" --json --surface)
-  steps=$(grep -o 'steps [0-9]*' study/run_${cell}.log | tail -1 | awk '{print $2}')
+  steps=$(grep -o ', steps [0-9]*' study/run_${cell}.log | tail -1 | awk '{print $3}')
   rate=$(grep -o '[0-9.]* million particle-steps/s' study/run_${cell}.log | awk '{print $1}')
   python3 - "$cell" "$c" "$s" "$start" "$end" "$steps" "$rate" >> "$table" <<'PY'
 import json, sys

@@ -400,7 +400,7 @@ TEST(SceneErrors, FilesNameFileLineAndKey) {
        "materials.copper.densty: unknown key (expected one of: density, youngs_modulus, "
        "poisson_ratio, strength, eos, failure)"},
       {"bad_unknown_top.toml", 19,
-       "outptu: unknown key (expected one of: scene, materials, bodies, grid, boundary, solver, "
+       "outptu: unknown key (expected one of: scene, materials, bodies, loads, grid, boundary, solver, "
        "output)"},
       {"bad_unknown_nested.toml", 9, "materials.copper.strength.hardening: unknown key"},
       {"bad_unknown_material.toml", 8,
@@ -597,11 +597,11 @@ TEST(SceneErrors, InlineCases) {
       {"negative history interval", end, end + "\n[output]\nhistory_interval = \"-1 us\"",
        "history_interval", "output.history_interval: must be >= 0, got '-1 us'"},
       {"dimension 4", "# minimal scene", "[scene]\ndimension = 4", "dimension",
-       "scene.dimension: must be 3, or 2 (plane strain in the x-y plane), got 4"},
+       "scene.dimension: must be 3, or 2 (the x-y plane), got 4"},
       {"title not a string", "# minimal scene", "[scene]\ntitle = 3", "title",
        "scene.title: expected a string, got 3 (an integer)"},
       {"unknown key in [scene]", "# minimal scene", "[scene]\ndimensions = 3", "dimensions",
-       "scene.dimensions: unknown key (expected one of: title, dimension)"},
+       "scene.dimensions: unknown key (expected one of: title, dimension, geometry)"},
   };
   for (const auto& c : cases) {
     std::string text = with(kBase, c.from, c.to);
