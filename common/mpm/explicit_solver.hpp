@@ -1,6 +1,8 @@
 #pragma once
 /// Explicit MPM: USF, USL and MUSL with leapfrog time integration (000, section 2;
-/// 004, sections 2 and 3.4). The time step is in explicit_solver.cpp, ExplicitSolver::step.
+/// 004, sections 2 and 3.4), in 3D, 2D plane strain and 2D axisymmetry, on any grid type
+/// that provides the interface described in grid.hpp (a uniform window here).
+/// The time step, ExplicitSolver::step, is at the top of explicit_solver_impl.hpp.
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -19,11 +21,12 @@
 
 namespace mpm {
 
-/// Energies (J; per metre of thickness in 2D) and momentum after a step.
+/// Energies (J; per metre of thickness in plane strain, per radian in axisymmetry) and
+/// momentum after a step.
 struct Balance {
-  double kinetic = 0;        ///< sum of m v^2 / 2
+  double kinetic = 0;        ///< sum of m v^2 / 2 over the deformable particles
   double internal = 0;       ///< sum of m e (elastic, plastic and shock heating)
-  double external_work = 0;  ///< work done on the particles by body forces since t = 0
+  double external_work = 0;  ///< work of body forces, loads and rigid bodies since t = 0
   double removed = 0;        ///< kinetic + internal energy of particles removed at the domain
   Vec3 momentum = Vec3::Zero();  ///< kg m/s
   /// kinetic + internal + removed - external_work. The kinetic energy is taken at the half
@@ -45,12 +48,15 @@ class InstabilityError : public std::runtime_error {
   std::string cause;
 };
 
-template <int D>
+template <class GridT>
 class ExplicitSolver {
  public:
-  /// Takes the particles (columns as written by mpm-prep; state columns are added). The
-  /// columns are reordered into cell order and stay owned by the caller.
-  ExplicitSolver(const Scene& scene, const Lattice& lattice, ColumnStore& particles);
+  static constexpr int D = GridT::kDim;
+
+  /// Takes the particles (columns as written by mpm-prep; state columns are added) and a grid
+  /// built for the scene. The columns are reordered into cell order and stay owned by the
+  /// caller.
+  ExplicitSolver(const Scene& scene, GridT grid, ColumnStore& particles);
   ~ExplicitSolver();
 
   /// One time step of size dt (at most stable_dt()). Throws InstabilityError.
@@ -67,9 +73,13 @@ class ExplicitSolver {
   double energy_scale() const { return energy_scale_; }
   /// Force (N) carried by each constrained face in the last step, positive when the material
   /// pushes against it; faces in the order x_min, x_max, y_min, y_max, z_min, z_max.
+  /// Per metre in plane strain, per radian in axisymmetry.
   const std::array<double, 6>& face_force() const { return face_force_; }
+  /// Force (N) the material exerts on each rigid body in the last step (zero for the others),
+  /// indexed by body.
+  const std::vector<Vec3>& rigid_force() const { return rigid_force_; }
   ColumnStore& particles() { return particles_; }
-  const Grid<D>& grid() const { return grid_; }
+  const GridT& grid() const { return grid_; }
   const Binning& binning() const { return binning_; }
   KernelTimers& timers() { return timers_; }
   std::size_t removed_particles() const { return removed_count_; }
@@ -77,7 +87,9 @@ class ExplicitSolver {
 
  private:
   enum Fields { kMass = 1, kMomentum = 2, kForce = 4 };
+  static constexpr int NMAX = GridT::kMaxNodes;
   struct ChunkStats;
+  struct StressScratch;
 
   // Kernels, in the order a step uses them.
   void sort_particles();
@@ -92,22 +104,28 @@ class ExplicitSolver {
 
   // Helpers.
   void apply_boundary(std::vector<Vec<D>>& vel, std::vector<Vec<D>>* acc, bool record_force);
-  void track_move(std::uint32_t i, std::int64_t bin_key, ChunkStats& s) const;
+  void track_move(const Vec<D>& x, std::uint32_t i, std::int64_t bin_key, ChunkStats& s) const;
   void finish(std::vector<ChunkStats>& stats, bool moved, bool stressed, bool velocity);
   void check_energy();
+  bool rigid(std::uint32_t i) const { return material_[i] == kRigidMaterial; }
 
   Scene scene_;
   ColumnStore& particles_;
-  Grid<D> grid_;
+  GridT grid_;
   Binning binning_;
   std::vector<Material> materials_;
   Scheme scheme_;
+  bool axisymmetric_ = false;
+  bool has_rigid_ = false;
+  std::vector<Vec<D>> rigid_velocity_;  ///< by body; zero for deformable bodies
+  std::vector<Vec3> rigid_force_;
   Vec<D> gravity_ = Vec<D>::Zero();
   double cfl_, dt_max_;
   double dt_ = 0, time_ = 0, stable_dt_ = 0;
   long steps_ = 0;
   double particle_steps_ = 0;
   bool need_sort_ = true;
+  const std::uint8_t* material_ = nullptr;  ///< refreshed with every view
   std::vector<std::uint32_t> exits_;  ///< particles that left the domain, removed at next sort
   std::size_t removed_count_ = 0;
   Balance balance_;
@@ -116,9 +134,12 @@ class ExplicitSolver {
   std::array<double, 6> face_force_{};
   double node_mass_floor_ = 0;  ///< nodes lighter than this are treated as empty
   std::vector<std::vector<std::uint32_t>> strays_;  ///< per thread
-  struct StressScratch;
   std::vector<std::unique_ptr<StressScratch>> scratch_;  ///< per thread
   KernelTimers timers_;
 };
+
+/// The uniform-grid solver of a scene: builds the window grid on the scene's lattice.
+template <int D>
+using UniformSolver = ExplicitSolver<UniformGrid<D>>;
 
 }  // namespace mpm

@@ -9,7 +9,7 @@
 namespace mpm {
 
 template <int D>
-Grid<D>::Grid(const Lattice& lattice, const BoundarySpec& boundary)
+UniformGrid<D>::UniformGrid(const Lattice& lattice, const BoundarySpec& boundary)
     : lattice_(lattice), boundary_(boundary), h_(lattice.h), inv_h_(1.0 / lattice.h) {
   if (lattice.dim != D) throw std::logic_error("lattice dimension does not match the solver");
   for (int a = 0; a < D; ++a) {
@@ -21,7 +21,7 @@ Grid<D>::Grid(const Lattice& lattice, const BoundarySpec& boundary)
 }
 
 template <int D>
-void Grid<D>::fit(const Vec<D>* x, std::size_t n, int margin) {
+void UniformGrid<D>::fit(const Vec<D>* x, std::size_t n, int margin) {
   // Bounding box of the particles' cells (a parallel min/max).
   IVec<D> lo = cells_, hi = IVec<D>::Constant(-1);
 #pragma omp parallel
@@ -70,6 +70,7 @@ void Grid<D>::fit(const Vec<D>* x, std::size_t n, int margin) {
   v.resize(s);
   a.resize(s);
   if (!v_remap.empty()) v_remap.resize(s);
+  if (!rigid.empty()) rigid.resize(s);
 
   // Nodes on constrained domain faces that the window reaches.
   fixed_.clear();
@@ -99,34 +100,36 @@ void Grid<D>::fit(const Vec<D>* x, std::size_t n, int margin) {
 }
 
 template <int D>
-IVec<D> Grid<D>::global_node(std::int64_t index) const {
+IVec<D> UniformGrid<D>::global_node(std::int64_t index) const {
   IVec<D> k;
   for (int a = 0; a < D; ++a) k[a] = int((index / stride_[a]) % nodes_[a]) + lo_[a];
   return k;
 }
 
 template <int D>
-void Grid<D>::clear(bool remap) {
+void UniformGrid<D>::clear(bool remap, bool rigid_bodies) {
   const std::int64_t n = std::int64_t(m.size());
   if (remap && v_remap.size() != m.size()) v_remap.resize(m.size());
+  if (rigid_bodies && rigid.size() != m.size()) rigid.resize(m.size());
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
     m[i] = 0;
     v[i].setZero();
     a[i].setZero();
     if (remap) v_remap[i].setZero();
+    if (rigid_bodies) rigid[i] = 0;
   }
 }
 
 template <int D>
-void Grid<D>::clear_remap() {
+void UniformGrid<D>::clear_remap() {
   const std::int64_t n = std::int64_t(m.size());
   if (v_remap.size() != m.size()) v_remap.resize(m.size());
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) v_remap[i].setZero();
 }
 
-template class Grid<2>;
-template class Grid<3>;
+template class UniformGrid<2>;
+template class UniformGrid<3>;
 
 }  // namespace mpm

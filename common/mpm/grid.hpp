@@ -15,10 +15,31 @@
 
 namespace mpm {
 
+/// Where a point lies relative to a grid.
+enum class Where : std::uint8_t { Window, OutsideWindow, OutsideDomain };
+
+// What the kernels need of a grid (UniformGrid here; a graded grid provides the same):
+//   static constexpr int kMaxNodes;     nodes of a cell, at most
+//   static constexpr bool kFixedNodes;  every cell has kMaxNodes nodes
+//   void fit(const Vec<D>* x, size_t n);              window/levels for these particles
+//   Where where(x, key, xi);                          cell key and local coordinates of x
+//   void locate(x, key, xi);                          the same for x known to be in the window
+//   int cell_nodes(key, nodes[]);                     node indices of a cell, returns the count
+//   void shape(key, xi, N[], G[]); values(key, xi, N[]);   shape functions, gradients in 1/m
+//   std::size_t key_count();                          keys are in [0, key_count())
+//   int layer(key); int layers();                     slab layers for the coloured scatter
+//   double cell_size(key); double min_cell_size();    m
+//   std::size_t nodes(); m, v, a, v_remap, rigid;     node data
+//   fixed_nodes(), slip_nodes();                      nodes on constrained domain faces
+
 template <int D>
-class Grid {
+class UniformGrid {
  public:
-  Grid(const Lattice& lattice, const BoundarySpec& boundary);
+  static constexpr int kDim = D;
+  static constexpr int kMaxNodes = kCorners<D>;
+  static constexpr bool kFixedNodes = true;
+
+  UniformGrid(const Lattice& lattice, const BoundarySpec& boundary);
 
   /// Fits the window to the cells of n particles (their bounding box widened by `margin`
   /// cells, clamped to the domain), chooses the slab axis (the longest), and sizes the node
@@ -45,6 +66,34 @@ class Grid {
       if (cell[a] < 0 || cell[a] >= cells_[a]) return false;
     return true;
   }
+  /// Cell key and local coordinates of a point known to be inside the window.
+  void locate(const Vec<D>& x, std::int64_t& key, Vec<D>& xi) const {
+    IVec<D> cell;
+    locate(x, cell, xi);
+    key = this->key(cell);
+  }
+  /// Where a point is; key and xi are set when it is in the window.
+  Where where(const Vec<D>& x, std::int64_t& key, Vec<D>& xi) const {
+    IVec<D> cell;
+    locate(x, cell, xi);
+    if (!in_domain(cell)) return Where::OutsideDomain;
+    if (!in_window(cell)) return Where::OutsideWindow;
+    key = this->key(cell);
+    return Where::Window;
+  }
+  /// Nodes of a cell (its corners); returns their number.
+  int cell_nodes(std::int64_t key, std::int64_t* nodes) const {
+    for (int c = 0; c < kMaxNodes; ++c) nodes[c] = key + corner_[c];
+    return kMaxNodes;
+  }
+  /// Shape functions and gradients (1/m) at local coordinates xi of a cell.
+  void shape(std::int64_t, const Vec<D>& xi, double* N, Vec<D>* G) const {
+    shape_functions<D>(xi, inv_h_, N, G);
+  }
+  void values(std::int64_t, const Vec<D>& xi, double* N) const { shape_values<D>(xi, N); }
+  std::size_t key_count() const { return m.size(); }
+  double cell_size(std::int64_t) const { return h_; }
+  double min_cell_size() const { return h_; }
   /// True when a global cell lies inside the window.
   bool in_window(const IVec<D>& cell) const {
     for (int a = 0; a < D; ++a)
@@ -75,8 +124,9 @@ class Grid {
   std::vector<Vec<D>> v;        ///< momentum, then velocity
   std::vector<Vec<D>> a;        ///< force, then acceleration
   std::vector<Vec<D>> v_remap;  ///< MUSL: remapped momentum, then velocity
-  /// Clears m, v and a (and v_remap when `remap`) over the window.
-  void clear(bool remap);
+  std::vector<std::uint8_t> rigid;  ///< 1 + index of the rigid body touching the node, or 0
+  /// Clears m, v and a (and v_remap when `remap`, rigid when `rigid_bodies`) over the window.
+  void clear(bool remap, bool rigid_bodies = false);
   void clear_remap();
 
   // Boundary conditions --------------------------------------------------------------------

@@ -43,11 +43,18 @@ void prepare_columns(ColumnStore& cols, const Scene& scene) {
   require(cols, col::material, ScalarType::U8, 1);
   require(cols, col::body, ScalarType::U8, 1);
   const auto* mat = cols.get<std::uint8_t>(col::material);
-  for (std::size_t i = 0; i < cols.size(); ++i)
+  const auto* body = cols.get<std::uint8_t>(col::body);
+  for (std::size_t i = 0; i < cols.size(); ++i) {
+    if (body[i] >= scene.bodies.size())
+      throw InputError("model", "particle " + std::to_string(i) + " refers to body " +
+                                    std::to_string(body[i]) + " but the scene has " +
+                                    std::to_string(scene.bodies.size()));
+    if (mat[i] == kRigidMaterial && scene.bodies[body[i]].rigid) continue;
     if (mat[i] >= scene.materials.size())
       throw InputError("model", "particle " + std::to_string(i) + " refers to material " +
                                     std::to_string(mat[i]) + " but the scene has " +
                                     std::to_string(scene.materials.size()));
+  }
   ensure(cols, {col::sigma, ScalarType::F64, 6, "Pa"});
   ensure(cols, {col::e, ScalarType::F64, 1, "J/kg"});
   const ColumnNeeds need = column_needs(scene);
@@ -57,7 +64,33 @@ void prepare_columns(ColumnStore& cols, const Scene& scene) {
     cols.add({col::T, ScalarType::F64, 1, "K"});
     double* T = cols.get<double>(col::T);
     for (std::size_t i = 0; i < cols.size(); ++i)
-      T[i] = scene.materials[mat[i]].strength.room_temperature;
+      T[i] = mat[i] == kRigidMaterial ? 0.0 : scene.materials[mat[i]].strength.room_temperature;
+  }
+  if (!scene.loads.empty() && !cols.has(col::f_ext)) {
+    // Each load's total force, shared equally among the particles of its body whose position
+    // at t = 0 lies in its region. Axisymmetric: the force is over the whole ring, the
+    // particles' equations are per radian.
+    cols.add({col::f_ext, ScalarType::F64, d, "N"});
+    auto* f = reinterpret_cast<double*>(cols.at(col::f_ext).data());
+    const auto* x = reinterpret_cast<const double*>(cols.at(col::x).data());
+    const double per = 1.0 / scene.measure_factor();
+    for (std::size_t l = 0; l < scene.loads.size(); ++l) {
+      const LoadSpec& load = scene.loads[l];
+      std::vector<std::size_t> picked;
+      for (std::size_t i = 0; i < cols.size(); ++i) {
+        if (body[i] != load.body) continue;
+        bool in = true;
+        for (int a = 0; a < d && load.region_given; ++a)
+          in = in && x[i * d + a] >= load.region_min[a] && x[i * d + a] <= load.region_max[a];
+        if (in) picked.push_back(i);
+      }
+      if (picked.empty())
+        throw InputError(where(load.loc.file, load.loc.line, load.loc.key),
+                         "the load selects no particle of body '" + scene.bodies[load.body].name +
+                             "' (check its region against the body's particles)");
+      for (auto i : picked)
+        for (int a = 0; a < d; ++a) f[i * d + a] += per * load.force[a] / double(picked.size());
+    }
   }
 }
 
@@ -74,6 +107,7 @@ ParticleView<D> view(ColumnStore& cols) {
   p.eps_p = cols.get<double>(col::eps_p);
   p.T = cols.get<double>(col::T);
   p.failed = cols.get<std::uint8_t>(col::failed);
+  p.f_ext = cols.get<Vec<D>>(col::f_ext);
   p.id = cols.get<std::uint32_t>(col::id);
   p.material = cols.get<std::uint8_t>(col::material);
   p.body = cols.get<std::uint8_t>(col::body);

@@ -26,6 +26,7 @@ inline const std::string e = "e";                ///< f64, specific internal ene
 inline const std::string eps_p = "eps_p";        ///< f64, equivalent plastic strain
 inline const std::string T = "T";                ///< f64, temperature, K
 inline const std::string failed = "failed";      ///< u8, 1 once the failure criterion was met
+inline const std::string f_ext = "f_ext";        ///< D x f64, applied force (loads), N
 }  // namespace col
 
 /// Material id of the particles of rigid bodies (they have no material).
@@ -45,6 +46,7 @@ struct ParticleView {
   double* eps_p = nullptr;
   double* T = nullptr;
   std::uint8_t* failed = nullptr;
+  Vec<D>* f_ext = nullptr;
   std::uint32_t* id = nullptr;
   std::uint8_t* material = nullptr;
   std::uint8_t* body = nullptr;
@@ -59,9 +61,10 @@ struct ColumnNeeds {
 ColumnNeeds column_needs(const Scene& scene);
 
 /// Adds the state columns a run needs to a model's columns (sigma, e and the optional ones),
-/// initialised to the unstressed state (T to each material's room temperature), and checks the
+/// initialised to the unstressed state (T to each material's room temperature; f_ext from the
+/// scene's loads, shared equally among the particles each load selects), and checks the
 /// model's own columns (x, v, m, rho, id, material, body) exist with the right shape.
-/// Throws InputError naming the missing or malformed column.
+/// Throws InputError naming the missing or malformed column, or a load that selects nothing.
 void prepare_columns(ColumnStore& cols, const Scene& scene);
 
 /// The view of a column store holding the columns of prepare_columns.

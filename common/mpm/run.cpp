@@ -68,7 +68,8 @@ Model read_model(const std::string& path) {
 /// History rows, written as HIST records at each frame and every few thousand rows.
 class History {
  public:
-  History(int dim, const BoundarySpec& bc) : dim_(dim) {
+  History(int dim, const Scene& scene) : dim_(dim), factor_(scene.measure_factor()) {
+    const BoundarySpec& bc = scene.boundary;
     add("step", "-");
     add("time", "s");
     add("dt", "s");
@@ -86,15 +87,25 @@ class History {
         faces_.push_back(f);
         add(std::string("force_") + face_name(f), "N");
       }
+    for (std::size_t b = 0; b < scene.bodies.size(); ++b)
+      if (scene.bodies[b].rigid) {
+        rigid_.push_back(int(b));
+        for (int a = 0; a < dim; ++a)
+          add("force_" + scene.bodies[b].name + "_" + "xyz"[a], "N");
+      }
   }
   template <class Solver>
   void record(const Solver& s, double dt) {
     const Balance& b = s.balance();
-    std::vector<double> row = {double(s.steps()), s.time(), dt, b.kinetic, b.internal,
-                               b.external_work, b.removed, b.total(), b.leapfrog_total};
-    for (int a = 0; a < dim_; ++a) row.push_back(b.momentum[a]);
+    // Extensive values as totals: per metre in plane strain, the whole ring in axisymmetry.
+    const double k = factor_;
+    std::vector<double> row = {double(s.steps()), s.time(), dt, k * b.kinetic, k * b.internal,
+                               k * b.external_work, k * b.removed, k * b.total(), k * b.leapfrog_total};
+    for (int a = 0; a < dim_; ++a) row.push_back(k * b.momentum[a]);
     row.push_back(double(const_cast<Solver&>(s).particles().size()));
-    for (int f : faces_) row.push_back(s.face_force()[f]);
+    for (int f : faces_) row.push_back(factor_ * s.face_force()[f]);
+    for (int b : rigid_)
+      for (int a = 0; a < dim_; ++a) row.push_back(factor_ * s.rigid_force()[b][a]);
     block_.values.insert(block_.values.end(), row.begin(), row.end());
   }
   void flush(StreamWriter& w) {
@@ -110,7 +121,8 @@ class History {
     block_.units.push_back(unit);
   }
   int dim_;
-  std::vector<int> faces_;
+  double factor_;
+  std::vector<int> faces_, rigid_;
   HistoryBlock block_;
 };
 
@@ -126,7 +138,7 @@ std::string run_info(const Scene& scene, const Lattice& lat, int threads) {
 template <int D>
 int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame& model) {
   const int threads = omp_get_max_threads();
-  ExplicitSolver<D> solver(scene, lattice, model.columns);
+  UniformSolver<D> solver(scene, UniformGrid<D>(lattice, scene.boundary), model.columns);
   StreamWriter out(opt.output);
   out.write_text(RecordType::Scene, scene.toml);
   out.write_text(RecordType::Info, run_info(scene, lattice, threads));
@@ -136,7 +148,7 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
   KernelTimers& timers = solver.timers();
   const int t_output = timers.id("output");
 
-  History history(D, scene.boundary);
+  History history(D, scene);
   auto emit_frame = [&](std::uint32_t flags) {
     ScopedTimer timer(timers, t_output);
     history.flush(out);

@@ -41,7 +41,7 @@ void conservation(Scheme scheme) {
     mass += p.m[i];
     for (int a = 0; a < D; ++a) mom0[a] += p.m[i] * p.v[i][a];
   }
-  ExplicitSolver<D> solver(s, lat, cols);
+  UniformSolver<D> solver(s, UniformGrid<D>(lat, s.boundary), cols);
   const double dt = 0.2 * solver.stable_dt();
   solver.step(dt);
   double grid_mass = 0;
@@ -82,7 +82,7 @@ TEST(Explicit, UniformTranslationKeepsZeroStress) {
     ColumnStore cols = block<3>(lat, IVec<3>(3, 5, 5), IVec<3>(9, 11, 11), 2, 7800,
                                 [&](const Vec3&) { return v0; });
     const std::vector<Vec3> x0(cols.get<Vec3>(col::x), cols.get<Vec3>(col::x) + cols.size());
-    ExplicitSolver<3> solver(s, lat, cols);
+    UniformSolver<3> solver(s, UniformGrid<3>(lat, s.boundary), cols);
     while (solver.time() < 40e-6) solver.step(solver.stable_dt());  // ~6 mm: crosses cells
     auto p = view<3>(cols);
     double smax = 0;
@@ -110,7 +110,7 @@ TEST(Explicit, UslSmallMassInstabilityIsStoppedByTheEnergyGuard) {
   const Vec3 v0(150.0, -40.0, 25.0);
   ColumnStore cols = block<3>(lat, IVec<3>(3, 5, 5), IVec<3>(9, 11, 11), 2, 7800,
                               [&](const Vec3&) { return v0; });
-  ExplicitSolver<3> solver(s, lat, cols);
+  UniformSolver<3> solver(s, UniformGrid<3>(lat, s.boundary), cols);
   try {
     while (solver.time() < 40e-6) solver.step(solver.stable_dt());
     FAIL() << "USL ran through; if it is now stable here, update docs/scene.md";
@@ -144,7 +144,7 @@ double spin_stress(int refine, double& angular_error) {
     return Lz;
   };
   const double Lz0 = angular(cols);
-  ExplicitSolver<3> solver(s, lat, cols);
+  UniformSolver<3> solver(s, UniformGrid<3>(lat, s.boundary), cols);
   const double t_end = 0.02 / w;  // 0.02 rad
   while (solver.time() < t_end) solver.step(std::min(solver.stable_dt(), t_end - solver.time()));
   auto p = view<3>(cols);
@@ -194,7 +194,7 @@ TEST(Explicit, ElasticWaveSpeedAndAmplitude) {
     const Lattice lat = lattice(3, Vec3::Zero(), h, {cells + 4, 1, 1});
     ColumnStore cols = block<3>(lat, IVec<3>(0, 0, 0), IVec<3>(cells, 1, 1), 2, rho,
                                 [&](const Vec3&) { return Vec3(-v0, 0, 0); });
-    ExplicitSolver<3> solver(s, lat, cols);
+    UniformSolver<3> solver(s, UniformGrid<3>(lat, s.boundary), cols);
     const double amplitude = rho * c * v0;  // 224 MPa
     const double T = cells * h / c, t1 = 0.3 * T, t2 = 0.7 * T;
     while (solver.time() < t1) solver.step(std::min(solver.stable_dt(), t1 - solver.time()));
@@ -227,7 +227,7 @@ double vibration(Scheme scheme, int cells, double& drift_4_periods) {
   ColumnStore cols = block<3>(lat, IVec<3>(0, 0, 0), IVec<3>(cells, 1, 1), 2, rho, [&](const Vec3& x) {
     return Vec3(v0 * std::sin(M_PI * x[0] / Lbar), 0, 0);
   });
-  ExplicitSolver<3> solver(s, lat, cols);
+  UniformSolver<3> solver(s, UniformGrid<3>(lat, s.boundary), cols);
   const double E0 = solver.balance().total();
   const double period = 2 * Lbar / c;
   double kmin = 1e300, swing = 0;
