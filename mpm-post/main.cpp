@@ -280,6 +280,86 @@ int cmd_taylor(const std::string& path, const TaylorArgs& a) {
   return conclude(path, s, frames);
 }
 
+// debris ----------------------------------------------------------------------------------
+struct DebrisArgs {
+  std::string time, axis, plane, target, projectile, expect_front, expect_width;
+  double percentile = 99.5;
+  bool json = false;
+};
+
+int cmd_debris(const std::string& path, const DebrisArgs& a) {
+  DebrisOptions opt;
+  opt.target = a.target;
+  opt.projectile = a.projectile;
+  opt.percentile = a.percentile;
+  if (!a.axis.empty()) {
+    if (a.axis != "x" && a.axis != "y" && a.axis != "z")
+      throw InputError("--axis", "expected x, y or z, got '" + a.axis + "'");
+    opt.axis = a.axis[0] - 'x';
+  }
+  if (!a.plane.empty()) opt.plane = quantity(a.plane, dim::length, "--plane");
+  std::optional<double> at;
+  if (!a.time.empty()) at = quantity(a.time, dim::time, "--time");
+  std::optional<Scene> scene;
+  std::optional<DebrisMeter> meter;
+  std::optional<DebrisResult> chosen;
+  double best = 1e300;
+  std::size_t frames = 0;
+  StreamVisitor v;
+  v.scene = [&](const std::string& t) { scene = scene_of(t, path); };
+  v.frame = [&](Frame&& f) {
+    ++frames;
+    if (!scene) throw StreamError(input_name(path), "a frame comes before the scene record");
+    if (!meter) meter.emplace(*scene, f, opt);
+    const double d = at ? std::abs(f.time - *at) : 0.0;
+    if (!at || d <= best) {
+      best = d;
+      chosen = meter->measure(f);
+    }
+  };
+  const StreamSummary s = read_stream(path, v);
+  if (!chosen) {
+    std::fprintf(stderr, "mpm-post: error: %s holds no frame to measure\n", input_name(path).c_str());
+    return kExitBadInput;
+  }
+  const DebrisResult& r = *chosen;
+  std::optional<double> ef, ew;
+  if (!a.expect_front.empty()) ef = quantity(a.expect_front, dim::length, "--expect-front");
+  if (!a.expect_width.empty()) ew = quantity(a.expect_width, dim::length, "--expect-width");
+  if (a.json) {
+    std::printf("{\"time\": %s, \"axis\": \"%c\", \"direction\": %d, \"plane\": %s, \"cloud_particles\": %zu, "
+                "\"particles\": %zu, \"percentile\": %s, \"front\": %s, \"width\": %s, "
+                "\"front_max\": %s, \"front_p99\": %s, \"front_p99_5\": %s, \"front_p99_9\": %s, "
+                "\"width_max\": %s, \"width_p99\": %s, \"width_p99_5\": %s, \"width_p99_9\": %s",
+                json_number(r.time).c_str(), "xyz"[r.axis], r.direction, json_number(r.plane).c_str(),
+                r.cloud, r.total, json_number(r.percentile).c_str(), json_number(r.front).c_str(),
+                json_number(r.width).c_str(), json_number(r.front_max).c_str(), json_number(r.front_p99).c_str(),
+                json_number(r.front_p995).c_str(), json_number(r.front_p999).c_str(),
+                json_number(r.width_max).c_str(), json_number(r.width_p99).c_str(),
+                json_number(r.width_p995).c_str(), json_number(r.width_p999).c_str());
+    if (ef) std::printf(", \"expected_front\": %s, \"error_front\": %s", json_number(*ef).c_str(), json_number(r.front / *ef - 1).c_str());
+    if (ew) std::printf(", \"expected_width\": %s, \"error_width\": %s", json_number(*ew).c_str(), json_number(r.width / *ew - 1).c_str());
+    std::printf("}\n");
+  } else {
+    std::printf("Debris cloud at t = %.4g us: %zu of %zu particles behind the plane %c = %.3f mm "
+                "(the target's rear face), impact along %s%c\n",
+                r.time * 1e6, r.cloud, r.total, "xyz"[r.axis], r.plane * 1e3, r.direction > 0 ? "+" : "-",
+                "xyz"[r.axis]);
+    std::printf("  %-8s %10s %10s %10s %10s\n", "mm", "max", "p99", "p99.5", "p99.9");
+    std::printf("  %-8s %10.1f %10.1f %10.1f %10.1f\n", "front", r.front_max * 1e3, r.front_p99 * 1e3,
+                r.front_p995 * 1e3, r.front_p999 * 1e3);
+    std::printf("  %-8s %10.1f %10.1f %10.1f %10.1f\n", "width", r.width_max * 1e3, r.width_p99 * 1e3,
+                r.width_p995 * 1e3, r.width_p999 * 1e3);
+    std::printf("  front = %.1f mm", r.front * 1e3);
+    if (ef) std::printf(" (expected %.1f mm, %+.1f%%)", *ef * 1e3, 100 * (r.front / *ef - 1));
+    std::printf(", width = %.1f mm", r.width * 1e3);
+    if (ew) std::printf(" (expected %.1f mm, %+.1f%%)", *ew * 1e3, 100 * (r.width / *ew - 1));
+    std::printf("   [%g-th percentile of the cloud's particles]\n", r.percentile);
+  }
+  std::fflush(stdout);
+  return conclude(path, s, frames);
+}
+
 // render ----------------------------------------------------------------------------------
 struct RenderArgs {
   std::string output = "frame.png", frame = "last", time, size = "1200x900", range;
@@ -372,6 +452,23 @@ int main(int argc, char** argv) {
   taylor->add_option("--expect-D", ta.expect_D, "reference diameter, e.g. \"13.5 mm\"");
   taylor->add_flag("--json", ta.json, "print JSON (SI units)");
 
+  auto* debris = app.add_subcommand("debris", "front and width of a debris cloud behind a struck plate");
+  DebrisArgs da;
+  debris->add_option("input", input, "stream, - for stdin")->capture_default_str();
+  debris->add_option("--time", da.time, "the frame nearest this time, e.g. \"30.6 us\" (default: the last)");
+  debris->add_option("--axis", da.axis, "impact axis x, y or z (default: the projectile's velocity)");
+  debris->add_option("--plane", da.plane, "reference plane along the axis, e.g. \"6.36 mm\" (default: the target's rear face)");
+  debris->add_option("--target", da.target, "target body (default: the first body at rest)");
+  debris->add_option("--projectile", da.projectile, "projectile body (default: the fastest body)");
+  debris->add_option("--percentile", da.percentile,
+                     "which particles count: the front and width reported are this percentile of the "
+                     "cloud's distances (stray particles beyond it are ignored; max and 99/99.5/99.9 are "
+                     "always printed)")
+      ->check(CLI::Range(0.0, 100.0))->capture_default_str();
+  debris->add_option("--expect-front", da.expect_front, "reference front, e.g. \"200 mm\"");
+  debris->add_option("--expect-width", da.expect_width, "reference width, e.g. \"145 mm\"");
+  debris->add_flag("--json", da.json, "print JSON (SI units)");
+
   auto* render = app.add_subcommand("render", "PNG picture of a frame, off-screen (works without a display)");
   RenderArgs ra;
   render->add_option("input", input, "stream, - for stdin")->capture_default_str();
@@ -400,6 +497,7 @@ int main(int argc, char** argv) {
     if (*history) return cmd_history(input, hist_out, hist_cols);
     if (*vtk) return cmd_vtk(input, vtk_dir, vtk_name, vtk_every);
     if (*taylor) return cmd_taylor(input, ta);
+    if (*debris) return cmd_debris(input, da);
     if (*render) {
       mpm::ensure_display(argc, argv);  // before reading: a re-run under xvfb reads stdin again
       return cmd_render(input, ra);

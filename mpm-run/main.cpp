@@ -23,6 +23,14 @@ int main(int argc, char** argv) {
                  "override a scene value, KEY=VALUE (e.g. solver.cfl=0.3); repeatable")
       ->allow_extra_args(false);
   app.add_flag("--stats", opt.stats, "print the per-kernel time table and throughput at the end");
+  app.add_option("--strategy", opt.strategy,
+                 "particle-to-grid scatter: colored (default; cell-ordered coloured chunks), "
+                 "lr-slabs (004 4.1), array-expansion (000 4.1.1), patch (000 4.1.2)")
+      ->check(CLI::IsMember({"colored", "lr-slabs", "array-expansion", "patch"}))
+      ->capture_default_str();
+  app.add_flag("--deterministic", opt.deterministic,
+               "results bitwise independent of the thread count (the colored strategy is; this "
+               "flag refuses the others)");
   app.add_option("--progress", progress, "progress on stderr: auto, bar, lines or none")
       ->check(CLI::IsMember({"auto", "bar", "lines", "none"}))
       ->capture_default_str();

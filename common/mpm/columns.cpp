@@ -38,10 +38,19 @@ void Column::check_view(std::size_t bytes) const {
                            std::to_string(info_.element_bytes()));
 }
 
+void Column::swap_storage(Buffer& buffer, std::size_t& buffer_bytes) {
+  const std::size_t eb = info_.element_bytes();
+  if (buffer_bytes < n_ * eb) throw std::logic_error("column buffer swap: buffer too small");
+  const std::size_t mine = capacity_ * eb;
+  data_.swap(buffer);
+  capacity_ = buffer_bytes / eb;
+  buffer_bytes = mine;
+}
+
 void Column::reserve(std::size_t n) {
   if (n <= capacity_) return;
   const std::size_t eb = info_.element_bytes();
-  std::unique_ptr<std::byte[], Free> fresh(
+  Buffer fresh(
       static_cast<std::byte*>(::operator new[](std::max<std::size_t>(n * eb, 64), std::align_val_t(64))));
   if (n_ > 0) std::memcpy(fresh.get(), data_.get(), n_ * eb);
   data_ = std::move(fresh);
@@ -91,13 +100,24 @@ void ColumnStore::reserve(std::size_t n) {
 
 void ColumnStore::gather(const std::vector<std::uint32_t>& perm) {
   const std::size_t m = perm.size();
-  std::size_t largest = 0;
-  for (auto& c : cols_) largest = std::max(largest, c.info().element_bytes());
-  if (scratch_.size() < m * largest) scratch_.resize(m * largest);
-  for (auto& c : cols_) {
-    const std::size_t eb = c.info().element_bytes();
-    const std::byte* src = c.data();
-    std::byte* dst = scratch_.data();
+  std::vector<Column*> order;
+  for (auto& c : cols_) order.push_back(&c);
+  std::stable_sort(order.begin(), order.end(), [](const Column* a, const Column* b) {
+    return a->info().element_bytes() > b->info().element_bytes();
+  });
+  if (order.empty()) {
+    n_ = m;
+    return;
+  }
+  const std::size_t widest = order.front()->info().element_bytes() * std::max<std::size_t>(m, 1);
+  if (spare_bytes_ < widest) {
+    spare_.reset(static_cast<std::byte*>(::operator new[](widest, std::align_val_t(64))));
+    spare_bytes_ = widest;
+  }
+  for (Column* c : order) {
+    const std::size_t eb = c->info().element_bytes();
+    const std::byte* src = c->data();
+    std::byte* dst = spare_.get();
     // Element sizes are small multiples of 1..48 bytes; memcpy of a constant size inlines.
     auto run = [&](auto width) {
       constexpr std::size_t w = decltype(width)::value;
@@ -115,8 +135,9 @@ void ColumnStore::gather(const std::vector<std::uint32_t>& perm) {
 #pragma omp parallel for schedule(static)
         for (std::size_t i = 0; i < m; ++i) std::memcpy(dst + i * eb, src + std::size_t(perm[i]) * eb, eb);
     }
-    c.resize(m);
-    std::memcpy(c.data(), scratch_.data(), m * eb);
+    if (m > c->size()) throw std::logic_error("gather: permutation longer than the columns");
+    c->resize(m);  // shrinking keeps the storage
+    c->swap_storage(spare_, spare_bytes_);
   }
   n_ = m;
 }

@@ -39,6 +39,14 @@ class Column {
   /// Reserves capacity for n elements.
   void reserve(std::size_t n);
   std::byte* data() { return data_.get(); }
+  /// Deleter of column buffers (64-byte aligned).
+  struct Free {
+    void operator()(std::byte* p) const { ::operator delete[](p, std::align_val_t(64)); }
+  };
+  using Buffer = std::unique_ptr<std::byte[], Free>;
+  /// Exchanges this column's storage with `buffer` of `buffer_bytes` bytes, which must hold
+  /// size() elements; the column keeps its size and takes the buffer's contents.
+  void swap_storage(Buffer& buffer, std::size_t& buffer_bytes);
   const std::byte* data() const { return data_.get(); }
   /// Typed view; T must have the size of one element (e.g. Eigen::Vector3d for 3 x f64).
   template <class T>
@@ -54,12 +62,9 @@ class Column {
 
  private:
   void check_view(std::size_t bytes) const;
-  struct Free {
-    void operator()(std::byte* p) const { ::operator delete[](p, std::align_val_t(64)); }
-  };
   ColumnInfo info_;
   std::size_t n_ = 0, capacity_ = 0;
-  std::unique_ptr<std::byte[], Free> data_;
+  Buffer data_;
 };
 
 /// A set of columns of equal length.
@@ -92,8 +97,9 @@ class ColumnStore {
   void resize(std::size_t n);
   void reserve(std::size_t n);
   /// Reorders every column so that new element i is old element perm[i] (a gather).
-  /// perm may be shorter than size() (elements not listed are dropped). Uses one scratch
-  /// buffer the size of the largest column, reused across calls.
+  /// perm may be shorter than size() (elements not listed are dropped). Gathers each column
+  /// into one spare buffer and swaps it in (widest columns first, so the spare always fits);
+  /// the spare is as large as the widest column and is kept for the next call.
   void gather(const std::vector<std::uint32_t>& perm);
   /// Bytes held by the columns (not counting scratch).
   std::size_t bytes() const;
@@ -103,7 +109,8 @@ class ColumnStore {
  private:
   std::size_t n_ = 0;
   std::vector<Column> cols_;
-  std::vector<std::byte> scratch_;
+  Column::Buffer spare_;
+  std::size_t spare_bytes_ = 0;
 };
 
 }  // namespace mpm

@@ -38,6 +38,21 @@ struct Balance {
   double leapfrog_total = 0;
 };
 
+/// How the particle-to-grid scatters avoid write races without locks or atomics.
+enum class ScatterStrategy {
+  Colored,         ///< default: cell-ordered chunks of slab layers in two colours, balanced by
+                   ///< particle count; the same bits for any thread count
+  LRSlabs,         ///< 004, section 4.1: one slab set per thread, each split into L and R
+                   ///< parts run alternately with a barrier between; re-balanced at every sort
+  ArrayExpansion,  ///< 000, section 4.1.1: thread-private node arrays, summed after
+  Patch,           ///< 000, section 4.1.2: uniform patches (slabs), one per thread, particles
+                   ///< indexed per patch (Pindex/patnp) each scatter, patches assembled after
+};
+/// "colored", "lr-slabs", "array-expansion", "patch".
+std::string to_string(ScatterStrategy s);
+/// Parses a strategy name; throws InputError(where, ...) listing the names when unknown.
+ScatterStrategy parse_strategy(const std::string& name, const std::string& where);
+
 /// A run that went unstable: the step, the particle (its id) and the cause.
 class InstabilityError : public std::runtime_error {
  public:
@@ -56,7 +71,8 @@ class ExplicitSolver {
   /// Takes the particles (columns as written by mpm-prep; state columns are added) and a grid
   /// built for the scene. The columns are reordered into cell order and stay owned by the
   /// caller.
-  ExplicitSolver(const Scene& scene, GridT grid, ColumnStore& particles);
+  ExplicitSolver(const Scene& scene, GridT grid, ColumnStore& particles,
+                 ScatterStrategy strategy = ScatterStrategy::Colored);
   ~ExplicitSolver();
 
   /// One time step of size dt (at most stable_dt()). Throws InstabilityError.
@@ -84,15 +100,36 @@ class ExplicitSolver {
   KernelTimers& timers() { return timers_; }
   std::size_t removed_particles() const { return removed_count_; }
   const Scene& scene() const { return scene_; }
+  ScatterStrategy strategy() const { return strategy_; }
+  /// Bytes held by the solver beyond the particle columns: grid window, private scatter
+  /// arrays, sort scratch and bins.
+  std::size_t work_bytes() const;
 
  private:
-  enum Fields { kMass = 1, kMomentum = 2, kForce = 4 };
+  enum Fields { kMass = 1, kMomentum = 2, kForce = 4, kRemap = 8 };
+  /// Node arrays a scatter writes into; node n is element n - offset.
+  struct Target {
+    double* m;
+    Vec<D>* v;
+    Vec<D>* a;
+    Vec<D>* q;
+    std::int64_t offset;
+  };
+  /// Private node arrays of one thread (array expansion) or one patch.
+  struct PrivateGrid {
+    std::vector<double> m;
+    std::vector<Vec<D>> v, a, q;
+    std::int64_t offset = 0, size = 0;
+  };
   static constexpr int NMAX = GridT::kMaxNodes;
   struct ChunkStats;
   struct StressScratch;
 
   // Kernels, in the order a step uses them.
   void sort_particles();
+  void mark_rigid_nodes();
+  template <class BinBody, class ParticleBody>
+  void scatter(int fields, BinBody&& bin_body, ParticleBody&& particle_body);
   template <int F>
   void p2g();
   void grid_velocity();
@@ -115,6 +152,9 @@ class ExplicitSolver {
   Binning binning_;
   std::vector<Material> materials_;
   Scheme scheme_;
+  ScatterStrategy strategy_;
+  std::vector<PrivateGrid> private_;  ///< array expansion: per thread; patch: per patch
+  std::vector<std::vector<std::uint32_t>> pindex_;  ///< patch: particles of each patch
   bool axisymmetric_ = false;
   bool has_rigid_ = false;
   std::vector<Vec<D>> rigid_velocity_;  ///< by body; zero for deformable bodies

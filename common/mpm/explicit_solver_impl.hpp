@@ -78,11 +78,13 @@ struct ExplicitSolver<GridT>::StressScratch {
 };
 
 template <class GridT>
-ExplicitSolver<GridT>::ExplicitSolver(const Scene& scene, GridT grid, ColumnStore& particles)
+ExplicitSolver<GridT>::ExplicitSolver(const Scene& scene, GridT grid, ColumnStore& particles,
+                                      ScatterStrategy strategy)
     : scene_(scene),
       particles_(particles),
       grid_(std::move(grid)),
       scheme_(scene.solver.scheme),
+      strategy_(strategy),
       axisymmetric_(D == 2 && scene.axisymmetric),
       cfl_(scene.solver.cfl),
       dt_max_(scene.solver.dt_max) {
@@ -97,6 +99,7 @@ ExplicitSolver<GridT>::ExplicitSolver(const Scene& scene, GridT grid, ColumnStor
       for (int a = 0; a < D; ++a) rigid_velocity_[b][a] = scene_.bodies[b].velocity[a];
     }
   const int threads = omp_get_max_threads();
+  if (strategy_ == ScatterStrategy::LRSlabs) binning_.target_chunks = 2 * threads;
   strays_.resize(threads);
   scratch_.resize(threads);
   for (auto& s : scratch_) s = std::make_unique<StressScratch>();
@@ -133,6 +136,16 @@ ExplicitSolver<GridT>::ExplicitSolver(const Scene& scene, GridT grid, ColumnStor
 
 template <class GridT>
 ExplicitSolver<GridT>::~ExplicitSolver() = default;
+
+template <class GridT>
+std::size_t ExplicitSolver<GridT>::work_bytes() const {
+  std::size_t b = grid_.nodes() * (sizeof(double) + 3 * sizeof(Vec<D>) + (has_rigid_ ? 1 : 0));
+  for (const auto& g : private_)
+    b += g.m.capacity() * sizeof(double) + (g.v.capacity() + g.a.capacity() + g.q.capacity()) * sizeof(Vec<D>);
+  for (const auto& pi : pindex_) b += pi.capacity() * sizeof(std::uint32_t);
+  b += binning_.bins().capacity() * sizeof(Bin) + binning_.chunks().capacity() * sizeof(Chunk);
+  return b;
+}
 
 template <class GridT>
 void ExplicitSolver<GridT>::sort_particles() {
@@ -243,10 +256,174 @@ void ExplicitSolver<GridT>::track_move(const Vec<D>& x, std::uint32_t i, std::in
 }
 
 // ------------------------------------------------------------------------------------------
+// Scatter driver: how particles write to nodes without races (ScatterStrategy). A scatter
+// kernel gives two bodies: bin_body(chunk, bin, target, strays) runs one bin with its cell's
+// nodes cached in registers; a particle outside its bin's slab layer goes to `strays` (when
+// not null) and later to particle_body(i, target, first_visit, chunk), which also serves the
+// patch strategy (first_visit: the particle's own update is still to do).
+
+template <class GridT>
+template <class BinBody, class ParticleBody>
+void ExplicitSolver<GridT>::scatter(int fields, BinBody&& bin_body, ParticleBody&& particle_body) {
+  const auto& chunks = binning_.chunks();
+  const int nchunks = binning_.chunk_count();
+  const Target global{grid_.m.data(), grid_.v.data(), grid_.a.data(), grid_.v_remap.data(), 0};
+  auto run_chunk = [&](int ch, const Target& t, std::vector<std::uint32_t>* strays) {
+    for (std::uint32_t bi = chunks[ch].bin_begin; bi < chunks[ch].bin_end; ++bi) bin_body(ch, bi, t, strays);
+  };
+  // Private arrays: clear the fields this scatter writes; add them into the grid afterwards.
+  auto clear = [&](PrivateGrid& g) {
+    const std::size_t n = std::size_t(g.size);
+    if (fields & kMass) g.m.assign(n, 0.0);
+    if (fields & kMomentum) g.v.assign(n, Vec<D>::Zero());
+    if (fields & kForce) g.a.assign(n, Vec<D>::Zero());
+    if (fields & kRemap) g.q.assign(n, Vec<D>::Zero());
+  };
+  auto target = [&](PrivateGrid& g) {
+    return Target{g.m.data(), g.v.data(), g.a.data(), g.q.data(), g.offset};
+  };
+  auto add_node = [&](const PrivateGrid& g, std::int64_t n) {
+    const std::int64_t k = n - g.offset;
+    if (fields & kMass) grid_.m[n] += g.m[k];
+    if (fields & kMomentum) grid_.v[n] += g.v[k];
+    if (fields & kForce) grid_.a[n] += g.a[k];
+    if (fields & kRemap) grid_.v_remap[n] += g.q[k];
+  };
+
+  switch (strategy_) {
+    case ScatterStrategy::Colored:
+    case ScatterStrategy::LRSlabs: {
+      // Two chunks of one colour never share a node: run a colour at a time. LR slabs give
+      // thread t the chunks 2t (L) and 2t + 1 (R), statically.
+      const bool lr = strategy_ == ScatterStrategy::LRSlabs;
+#pragma omp parallel
+      {
+        auto& strays = strays_[omp_get_thread_num()];
+        strays.clear();
+        for (int color = 0; color < 2; ++color) {
+          if (lr) {
+#pragma omp for schedule(static, 1)
+            for (int ch = color; ch < nchunks; ch += 2) run_chunk(ch, global, &strays);
+          } else {
+#pragma omp for schedule(dynamic, 1)
+            for (int ch = color; ch < nchunks; ch += 2) run_chunk(ch, global, &strays);
+          }
+        }
+      }
+      std::vector<std::uint32_t> all;
+      for (auto& st : strays_) all.insert(all.end(), st.begin(), st.end());
+      std::sort(all.begin(), all.end());  // serially, in particle order
+      for (auto i : all) particle_body(i, global, false, -1);
+      break;
+    }
+    case ScatterStrategy::ArrayExpansion: {
+      const int threads = omp_get_max_threads();
+      private_.resize(threads);
+      const std::int64_t n = std::int64_t(grid_.nodes());
+#pragma omp parallel
+      {
+        PrivateGrid& mine = private_[omp_get_thread_num()];
+        mine.offset = 0;
+        mine.size = n;
+        clear(mine);
+        const Target t = target(mine);
+#pragma omp for schedule(static)
+        for (int ch = 0; ch < nchunks; ++ch) run_chunk(ch, t, nullptr);
+        // A(:) = sum_j A_list(:, j) (000, eq. 16), in thread order at every node.
+#pragma omp for schedule(static)
+        for (std::int64_t node = 0; node < n; ++node)
+          for (int j = 0; j < threads; ++j) add_node(private_[j], node);
+      }
+      break;
+    }
+    case ScatterStrategy::Patch: {
+      if constexpr (requires { grid_.layer_stride(); }) {
+        // Uniform patches along the slab axis, one per thread (000, section 4.1.2). Pindex and
+        // patnp are rebuilt each scatter from the particles' current cells, in parallel:
+        // patnp_th(j, p) counts particles of patch p in thread j's share.
+        const int np = omp_get_max_threads();
+        const int layers = grid_.layers();
+        const std::int64_t S = grid_.layer_stride();
+        const ParticleView<D> pv = view<D>(particles_);
+        const std::size_t n = pv.n;
+        std::vector<std::uint16_t> patch_of(n);
+        std::vector<std::vector<std::size_t>> patnp_th(np, std::vector<std::size_t>(np, 0));
+        // Patch pp holds the cell layers [pp layers / np, (pp + 1) layers / np).
+        std::vector<std::uint16_t> patch_of_layer(layers);
+        for (int pp = 0; pp < np; ++pp)
+          for (int l = pp * layers / np; l < (pp + 1) * layers / np; ++l) patch_of_layer[l] = std::uint16_t(pp);
+        pindex_.resize(np);
+#pragma omp parallel
+        {
+          const int j = omp_get_thread_num();
+#pragma omp for schedule(static)
+          for (std::size_t i = 0; i < n; ++i) {
+            std::int64_t key;
+            Vec<D> xi;
+            grid_.locate(pv.x[i], key, xi);
+            const int pp = patch_of_layer[grid_.layer(key)];
+            patch_of[i] = std::uint16_t(pp);
+            ++patnp_th[j][pp];
+          }
+#pragma omp single
+          for (int pp = 0; pp < np; ++pp) {
+            std::size_t patnp = 0;
+            for (int jj = 0; jj < np; ++jj) {
+              const std::size_t c = patnp_th[jj][pp];
+              patnp_th[jj][pp] = patnp;  // becomes thread jj's first slot in Pindex(:, pp)
+              patnp += c;
+            }
+            pindex_[pp].resize(patnp);
+          }
+#pragma omp for schedule(static)
+          for (std::size_t i = 0; i < n; ++i) pindex_[patch_of[i]][patnp_th[j][patch_of[i]]++] = std::uint32_t(i);
+        }
+        private_.resize(np);
+#pragma omp parallel for schedule(static, 1)
+        for (int pp = 0; pp < np; ++pp) {
+          PrivateGrid& g = private_[pp];
+          const std::int64_t l0 = std::int64_t(pp) * layers / np, l1 = std::int64_t(pp + 1) * layers / np;
+          g.offset = l0 * S;
+          g.size = std::min<std::int64_t>((l1 + 1) * S, std::int64_t(grid_.nodes())) - g.offset;
+          clear(g);
+          const Target t = target(g);
+          for (auto i : pindex_[pp]) particle_body(i, t, true, pp);
+        }
+        // Assemble the patches into the grid, patch by patch (neighbours share a node layer).
+        for (int pp = 0; pp < np; ++pp) {
+          const PrivateGrid& g = private_[pp];
+#pragma omp parallel for schedule(static)
+          for (std::int64_t k = 0; k < g.size; ++k) add_node(g, g.offset + k);
+        }
+      } else {
+        throw InputError("--strategy", "the patch strategy needs a uniform grid");
+      }
+      break;
+    }
+  }
+}
+
+// Rigid particles mark the nodes they touch with their body (no-slip contact), serially:
+// they are few, and a node touched by two rigid bodies then takes the later one's mark.
+template <class GridT>
+void ExplicitSolver<GridT>::mark_rigid_nodes() {
+  const ParticleView<D> p = view<D>(particles_);
+  for (std::size_t i = 0; i < p.n; ++i) {
+    if (p.material[i] != kRigidMaterial) continue;
+    std::int64_t key, nodes[NMAX];
+    Vec<D> xi;
+    double N[NMAX];
+    grid_.locate(p.x[i], key, xi);
+    grid_.values(key, xi, N);
+    const int nn = grid_.cell_nodes(key, nodes);
+    for (int c = 0; c < nn; ++c)
+      if (N[c] > 0) grid_.rigid[nodes[c]] = std::uint8_t(p.body[i] + 1);
+  }
+}
+
+// ------------------------------------------------------------------------------------------
 // Particle to grid (000, eqs. 1-5): lumped mass, momentum, internal force, body forces and
-// loads; rigid particles mark the nodes they touch instead. Chunks of one colour run in
-// parallel; a particle in its bin's cell adds into registers flushed once per cell, one
-// outside its bin's layer (a stray) is done serially at the end.
+// loads. A particle in its bin's cell adds into registers flushed once per cell.
 
 template <class GridT>
 template <int F>
@@ -255,37 +432,22 @@ void ExplicitSolver<GridT>::p2g() {
                                         : (F & kForce) ? "p2g"
                                                        : "p2g_mass_momentum"));
   constexpr bool kM = F & kMass, kP = F & kMomentum, kF = F & kForce;
-  if constexpr (kM) grid_.clear(scheme_ == Scheme::MUSL, has_rigid_);
+  if constexpr (kM) {
+    grid_.clear(scheme_ == Scheme::MUSL, has_rigid_);
+    if (has_rigid_) mark_rigid_nodes();
+  }
   const ParticleView<D> p = view<D>(particles_);
   material_ = p.material;
-  double* m_i = grid_.m.data();
-  Vec<D>* p_i = grid_.v.data();
-  Vec<D>* f_i = grid_.a.data();
-  std::uint8_t* rigid_i = has_rigid_ ? grid_.rigid.data() : nullptr;
   const auto& bins = binning_.bins();
-  const auto& chunks = binning_.chunks();
-  const int nchunks = binning_.chunk_count();
   const Vec<D> b = gravity_;
   const bool axi = axisymmetric_;
 
   // Contribution of particle i (cell `key`, local coordinates xi) through add(c, dm, dp, df).
-  auto contribute = [&](std::uint32_t i, std::int64_t key, const Vec<D>& xi, auto&& add) {
+  auto contribute = [&](std::uint32_t i, std::int64_t key, const Vec<D>& xi, int nn, auto&& add) {
     double N[NMAX];
     Vec<D> G[NMAX];
     if constexpr (kF) grid_.shape(key, xi, N, G);
     else grid_.values(key, xi, N);
-    std::int64_t cell[NMAX];
-    const int nn = GridT::kFixedNodes ? NMAX : grid_.cell_nodes(key, cell);
-    if (rigid(i)) {  // rigid bodies impose their velocity on the nodes they touch
-      if constexpr (kM) {
-        if (rigid_i) {
-          grid_.cell_nodes(key, cell);
-          for (int c = 0; c < nn; ++c)
-            if (N[c] > 0) rigid_i[cell[c]] = std::uint8_t(p.body[i] + 1);
-        }
-      }
-      return;
-    }
     const double m_p = p.m[i];
     const Vec<D> mv_p = m_p * p.v[i];
     Mat<D> Vsigma = Mat<D>::Zero();  // V_p sigma_p, in-plane part
@@ -300,71 +462,65 @@ void ExplicitSolver<GridT>::p2g() {
     for (int c = 0; c < nn; ++c) {
       Vec<D> df = Vec<D>::Zero();
       if constexpr (kF) {
-        df = N[c] * fb - Vsigma * G[c];  // (000, eqs. 4-5)
+        df = N[c] * fb - Vsigma * G[c];      // (000, eqs. 4-5)
         if (axi) df[0] -= Vs_hoop_r * N[c];  // hoop stress (Sulsky & Schreyer 1996)
       }
       add(c, m_p * N[c], N[c] * mv_p, df);
     }
   };
-  auto to_grid = [&](std::int64_t key) {
-    std::array<std::int64_t, NMAX> nodes;
-    grid_.cell_nodes(key, nodes.data());
-    return [&, nodes](int c, double dm, const Vec<D>& dp, const Vec<D>& df) {
-      const std::int64_t n = nodes[c];
-      if constexpr (kM) m_i[n] += dm;
-      if constexpr (kP) p_i[n] += dp;
-      if constexpr (kF) f_i[n] += df;
+  // Writes into a target at the nodes of a cell.
+  auto to_target = [&](const Target& t, const std::int64_t* nodes) {
+    return [&t, nodes](int c, double dm, const Vec<D>& dp, const Vec<D>& df) {
+      const std::int64_t n = nodes[c] - t.offset;
+      if constexpr (kM) t.m[n] += dm;
+      if constexpr (kP) t.v[n] += dp;
+      if constexpr (kF) t.a[n] += df;
     };
   };
-
-#pragma omp parallel
-  {
-    auto& strays = strays_[omp_get_thread_num()];
-    strays.clear();
-    for (int color = 0; color < 2; ++color) {
-#pragma omp for schedule(dynamic, 1)
-      for (int ch = color; ch < nchunks; ch += 2) {
-        for (std::uint32_t bi = chunks[ch].bin_begin; bi < chunks[ch].bin_end; ++bi) {
-          const Bin& bin = bins[bi];
-          const int layer = grid_.layer(bin.key);
-          std::int64_t nodes[NMAX];
-          const int nn = grid_.cell_nodes(bin.key, nodes);
-          double m_c[NMAX] = {};
-          Vec<D> p_c[NMAX], f_c[NMAX];
-          for (int c = 0; c < nn; ++c) p_c[c].setZero(), f_c[c].setZero();
-          auto to_cell = [&](int c, double dm, const Vec<D>& dp, const Vec<D>& df) {
-            if constexpr (kM) m_c[c] += dm;
-            if constexpr (kP) p_c[c] += dp;
-            if constexpr (kF) f_c[c] += df;
-          };
-          for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
-            std::int64_t key;
-            Vec<D> xi;
-            grid_.locate(p.x[i], key, xi);
-            if (key == bin.key) contribute(i, key, xi, to_cell);
-            else if (grid_.layer(key) == layer) contribute(i, key, xi, to_grid(key));
-            else strays.push_back(i);
-          }
-          for (int c = 0; c < nn; ++c) {
-            const std::int64_t n = nodes[c];
-            if constexpr (kM) m_i[n] += m_c[c];
-            if constexpr (kP) p_i[n] += p_c[c];
-            if constexpr (kF) f_i[n] += f_c[c];
-          }
-        }
-      }
-    }
-  }
-  // Strays, serially and in particle order.
-  std::vector<std::uint32_t> all;
-  for (auto& s : strays_) all.insert(all.end(), s.begin(), s.end());
-  std::sort(all.begin(), all.end());
-  for (auto i : all) {
-    std::int64_t key;
+  auto particle_body = [&](std::uint32_t i, const Target& t, bool, int) {
+    if (rigid(i)) return;
+    std::int64_t key, nodes[NMAX];
     Vec<D> xi;
     grid_.locate(p.x[i], key, xi);
-    contribute(i, key, xi, to_grid(key));
-  }
+    const int nn = grid_.cell_nodes(key, nodes);
+    contribute(i, key, xi, nn, to_target(t, nodes));
+  };
+  auto bin_body = [&](int, std::uint32_t bi, const Target& t, std::vector<std::uint32_t>* strays) {
+    const Bin& bin = bins[bi];
+    const int layer = grid_.layer(bin.key);
+    std::int64_t nodes[NMAX];
+    const int nn = grid_.cell_nodes(bin.key, nodes);
+    double m_c[NMAX] = {};
+    Vec<D> p_c[NMAX], f_c[NMAX];
+    for (int c = 0; c < nn; ++c) p_c[c].setZero(), f_c[c].setZero();
+    auto to_cell = [&](int c, double dm, const Vec<D>& dp, const Vec<D>& df) {
+      if constexpr (kM) m_c[c] += dm;
+      if constexpr (kP) p_c[c] += dp;
+      if constexpr (kF) f_c[c] += df;
+    };
+    for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
+      if (rigid(i)) continue;
+      std::int64_t key;
+      Vec<D> xi;
+      grid_.locate(p.x[i], key, xi);
+      if (key == bin.key) {
+        contribute(i, key, xi, nn, to_cell);
+      } else if (!strays || grid_.layer(key) == layer) {
+        std::int64_t other[NMAX];
+        const int nk = grid_.cell_nodes(key, other);
+        contribute(i, key, xi, nk, to_target(t, other));
+      } else {
+        strays->push_back(i);
+      }
+    }
+    for (int c = 0; c < nn; ++c) {
+      const std::int64_t n = nodes[c] - t.offset;
+      if constexpr (kM) t.m[n] += m_c[c];
+      if constexpr (kP) t.v[n] += p_c[c];
+      if constexpr (kF) t.a[n] += f_c[c];
+    }
+  };
+  scatter(F, bin_body, particle_body);
 }
 
 // ------------------------------------------------------------------------------------------
@@ -421,7 +577,7 @@ void ExplicitSolver<GridT>::grid_velocity() {
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
     if (grid_.m[i] > floor) grid_.v[i] /= grid_.m[i];
-    else grid_.v[i].setZero();
+    else if (!grid_.v[i].isZero()) grid_.v[i].setZero();  // keep empty nodes at zero
   }
   apply_boundary(grid_.v, nullptr, false);
 }
@@ -439,7 +595,7 @@ void ExplicitSolver<GridT>::grid_update(bool momentum_in_v) {
       const Vec<D> v_i = momentum_in_v ? Vec<D>(grid_.v[i] / m) : grid_.v[i];
       grid_.v[i] = v_i + dt * a_i;  // p_i^{k+1} = p_i^k + f_i dt, divided by m_i
       grid_.a[i] = a_i;
-    } else {
+    } else if (!grid_.v[i].isZero() || !grid_.a[i].isZero()) {  // keep empty nodes at zero
       grid_.v[i].setZero();
       grid_.a[i].setZero();
     }
@@ -455,14 +611,14 @@ void ExplicitSolver<GridT>::grid_remap() {
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
     if (grid_.m[i] > floor) grid_.v_remap[i] /= grid_.m[i];
-    else grid_.v_remap[i].setZero();
+    else if (!grid_.v_remap[i].isZero()) grid_.v_remap[i].setZero();  // keep empty nodes at zero
   }
   apply_boundary(grid_.v_remap, nullptr, false);
 }
 
 // ------------------------------------------------------------------------------------------
 // Grid to particle: velocity (000, eqs. 8, 10), position when Move (eqs. 7, 9), and for MUSL
-// the remapped momentum m_p v_p back to the grid (eq. 11), a scatter done by colours. Rigid
+// the remapped momentum m_p v_p back to the grid (eq. 11), a scatter (see scatter()). Rigid
 // particles keep their velocity and, when Move, advance with it.
 
 template <class GridT>
@@ -473,102 +629,109 @@ void ExplicitSolver<GridT>::g2p() {
   material_ = p.material;
   const Vec<D>* a_i = grid_.a.data();
   const Vec<D>* v_i = grid_.v.data();
-  Vec<D>* q_i = grid_.v_remap.data();
   const auto& bins = binning_.bins();
-  const auto& chunks = binning_.chunks();
   const int nchunks = binning_.chunk_count();
   const double dt = dt_;
   const Vec<D> b = gravity_;
-  std::vector<ChunkStats> stats(nchunks);
+  std::vector<ChunkStats> stats(std::max(nchunks, omp_get_max_threads()));
 
-  auto chunk_body = [&](int ch, std::vector<std::uint32_t>& strays) {
-    ChunkStats& s = stats[ch];
-    for (std::uint32_t bi = chunks[ch].bin_begin; bi < chunks[ch].bin_end; ++bi) {
-      const Bin& bin = bins[bi];
-      const int layer = grid_.layer(bin.key);
-      std::int64_t nodes[NMAX], other[NMAX];
-      const int nn = grid_.cell_nodes(bin.key, nodes);
-      Vec<D> a_c[NMAX], v_c[NMAX], q_c[NMAX];
-      for (int c = 0; c < nn; ++c) {
-        a_c[c] = a_i[nodes[c]];
-        if constexpr (Move) v_c[c] = v_i[nodes[c]];
-        q_c[c].setZero();
-      }
-      for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
-        if (rigid(i)) {
-          if constexpr (Move) {
-            p.x[i] += dt * p.v[i];
-            track_move(p.x[i], i, bin.key, s);
-          }
-          continue;
-        }
-        std::int64_t key;
-        Vec<D> xi;
-        grid_.locate(p.x[i], key, xi);
-        const bool home = key == bin.key;
-        const int nk = home ? nn : grid_.cell_nodes(key, other);
-        const std::int64_t* nd = home ? nodes : other;
-        double N[NMAX];
-        grid_.values(key, xi, N);
-        Vec<D> a_p = Vec<D>::Zero(), vbar = Vec<D>::Zero();
-        for (int c = 0; c < nk; ++c) {
-          a_p += N[c] * (home ? a_c[c] : a_i[nd[c]]);
-          if constexpr (Move) vbar += N[c] * (home ? v_c[c] : v_i[nd[c]]);
-        }
-        const Vec<D> v_old = p.v[i];
-        p.v[i] += dt * a_p;  // (000, eq. 8)
-        s.leapfrog_kinetic += 0.5 * p.m[i] * v_old.dot(p.v[i]);
-        if constexpr (Move) {
-          p.x[i] += dt * vbar;  // (000, eq. 7)
-          s.kinetic += 0.5 * p.m[i] * p.v[i].squaredNorm();
-          for (int a = 0; a < D; ++a) s.momentum[a] += p.m[i] * p.v[i][a];
-          s.work += dt * (p.m[i] * b + (p.f_ext ? p.f_ext[i] : Vec<D>::Zero())).dot(p.v[i]);
-          track_move(p.x[i], i, bin.key, s);
-        }
-        if constexpr (Remap) {
-          const Vec<D> mv = p.m[i] * p.v[i];
-          if (home) {
-            for (int c = 0; c < nk; ++c) q_c[c] += N[c] * mv;
-          } else if (grid_.layer(key) == layer) {
-            for (int c = 0; c < nk; ++c) q_i[nd[c]] += N[c] * mv;
-          } else {
-            strays.push_back(i);
-          }
-        }
-      }
-      if constexpr (Remap)
-        for (int c = 0; c < nn; ++c) q_i[nodes[c]] += q_c[c];
+  // The velocity (and position) update of particle i from nodal values at the nodes of its
+  // cell; returns its shape function values in N for the remap.
+  auto update = [&](std::uint32_t i, std::int64_t key, const Vec<D>& xi, const std::int64_t* nd,
+                    int nk, const Vec<D>* a_c, const Vec<D>* v_c, double* N, ChunkStats& s,
+                    std::int64_t bin_key) {
+    grid_.values(key, xi, N);
+    Vec<D> a_p = Vec<D>::Zero(), vbar = Vec<D>::Zero();
+    for (int c = 0; c < nk; ++c) {
+      a_p += N[c] * (a_c ? a_c[c] : a_i[nd[c]]);
+      if constexpr (Move) vbar += N[c] * (v_c ? v_c[c] : v_i[nd[c]]);
+    }
+    const Vec<D> v_old = p.v[i];
+    p.v[i] += dt * a_p;  // (000, eq. 8)
+    s.leapfrog_kinetic += 0.5 * p.m[i] * v_old.dot(p.v[i]);
+    if constexpr (Move) {
+      p.x[i] += dt * vbar;  // (000, eq. 7)
+      s.kinetic += 0.5 * p.m[i] * p.v[i].squaredNorm();
+      for (int a = 0; a < D; ++a) s.momentum[a] += p.m[i] * p.v[i][a];
+      s.work += dt * (p.m[i] * b + (p.f_ext ? p.f_ext[i] : Vec<D>::Zero())).dot(p.v[i]);
+      track_move(p.x[i], i, bin_key, s);
     }
   };
-
-#pragma omp parallel
-  {
-    auto& strays = strays_[omp_get_thread_num()];
-    strays.clear();
-    if constexpr (Remap) {
-      for (int color = 0; color < 2; ++color) {
-#pragma omp for schedule(dynamic, 1)
-        for (int ch = color; ch < nchunks; ch += 2) chunk_body(ch, strays);
-      }
-    } else {
-#pragma omp for schedule(dynamic, 1)
-      for (int ch = 0; ch < nchunks; ++ch) chunk_body(ch, strays);
+  auto move_rigid = [&](std::uint32_t i, ChunkStats& s, std::int64_t bin_key) {
+    if constexpr (Move) {
+      p.x[i] += dt * p.v[i];
+      track_move(p.x[i], i, bin_key, s);
     }
-  }
-  if constexpr (Remap) {
-    std::vector<std::uint32_t> all;
-    for (auto& s : strays_) all.insert(all.end(), s.begin(), s.end());
-    std::sort(all.begin(), all.end());
-    for (auto i : all) {
+  };
+  // One particle on its own: update (when first visited) and remap into a target.
+  auto particle_body = [&](std::uint32_t i, const Target& t, bool first_visit, int unit) {
+    std::int64_t key, nd[NMAX];
+    Vec<D> xi;
+    grid_.locate(p.x[i], key, xi);
+    if (first_visit && rigid(i)) {
+      move_rigid(i, stats[unit], key);
+      return;
+    }
+    if (rigid(i)) return;
+    const int nk = grid_.cell_nodes(key, nd);
+    double N[NMAX];
+    if (first_visit) update(i, key, xi, nd, nk, nullptr, nullptr, N, stats[unit], key);
+    else grid_.values(key, xi, N);
+    if constexpr (Remap) {
+      const Vec<D> mv = p.m[i] * p.v[i];
+      for (int c = 0; c < nk; ++c) t.q[nd[c] - t.offset] += N[c] * mv;
+    }
+  };
+  // One bin with its cell's nodal values cached.
+  auto bin_body = [&](int ch, std::uint32_t bi, const Target& t, std::vector<std::uint32_t>* strays) {
+    ChunkStats& s = stats[ch];
+    const Bin& bin = bins[bi];
+    const int layer = grid_.layer(bin.key);
+    std::int64_t nodes[NMAX], other[NMAX];
+    const int nn = grid_.cell_nodes(bin.key, nodes);
+    Vec<D> a_c[NMAX], v_c[NMAX], q_c[NMAX];
+    for (int c = 0; c < nn; ++c) {
+      a_c[c] = a_i[nodes[c]];
+      if constexpr (Move) v_c[c] = v_i[nodes[c]];
+      q_c[c].setZero();
+    }
+    for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
+      if (rigid(i)) {
+        move_rigid(i, s, bin.key);
+        continue;
+      }
       std::int64_t key;
       Vec<D> xi;
       grid_.locate(p.x[i], key, xi);
+      const bool home = key == bin.key;
+      const int nk = home ? nn : grid_.cell_nodes(key, other);
+      const std::int64_t* nd = home ? nodes : other;
       double N[NMAX];
-      std::int64_t nd[NMAX];
-      grid_.values(key, xi, N);
-      const int nk = grid_.cell_nodes(key, nd);
-      for (int c = 0; c < nk; ++c) q_i[nd[c]] += N[c] * (p.m[i] * p.v[i]);
+      update(i, key, xi, nd, nk, home ? a_c : nullptr, home ? v_c : nullptr, N, s, bin.key);
+      if constexpr (Remap) {
+        const Vec<D> mv = p.m[i] * p.v[i];
+        if (home) {
+          for (int c = 0; c < nk; ++c) q_c[c] += N[c] * mv;
+        } else if (!strays || grid_.layer(key) == layer) {
+          for (int c = 0; c < nk; ++c) t.q[nd[c] - t.offset] += N[c] * mv;
+        } else {
+          strays->push_back(i);
+        }
+      }
     }
+    if constexpr (Remap)
+      for (int c = 0; c < nn; ++c) t.q[nodes[c] - t.offset] += q_c[c];
+  };
+
+  if constexpr (Remap) {
+    scatter(kRemap, bin_body, particle_body);
+  } else {  // a gather: any chunk on any thread
+    const auto& chunks = binning_.chunks();
+    const Target none{nullptr, nullptr, nullptr, nullptr, 0};
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int ch = 0; ch < nchunks; ++ch)
+      for (std::uint32_t bi = chunks[ch].bin_begin; bi < chunks[ch].bin_end; ++bi)
+        bin_body(ch, bi, none, nullptr);
   }
   finish(stats, Move, false, true);
 }

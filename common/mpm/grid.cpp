@@ -66,6 +66,7 @@ void UniformGrid<D>::fit(const Vec<D>* x, std::size_t n, int margin) {
       if ((c >> a) & 1) off += stride_[a];
     corner_[c] = off;
   }
+  clean_ = false;  // the arrays now mean other nodes: clear them all next time
   m.resize(s);
   v.resize(s);
   a.resize(s);
@@ -109,24 +110,22 @@ IVec<D> UniformGrid<D>::global_node(std::int64_t index) const {
 template <int D>
 void UniformGrid<D>::clear(bool remap, bool rigid_bodies) {
   const std::int64_t n = std::int64_t(m.size());
+  const bool full = !clean_ || (remap && v_remap.size() != m.size());
   if (remap && v_remap.size() != m.size()) v_remap.resize(m.size());
   if (rigid_bodies && rigid.size() != m.size()) rigid.resize(m.size());
+  // A node without mass holds no momentum, force or remapped momentum (the grid kernels keep it
+  // so), so only the nodes that carried mass need clearing: empty nodes cost one read.
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
-    m[i] = 0;
-    v[i].setZero();
-    a[i].setZero();
-    if (remap) v_remap[i].setZero();
+    if (full || m[i] != 0) {
+      m[i] = 0;
+      v[i].setZero();
+      a[i].setZero();
+      if (remap) v_remap[i].setZero();
+    }
     if (rigid_bodies) rigid[i] = 0;
   }
-}
-
-template <int D>
-void UniformGrid<D>::clear_remap() {
-  const std::int64_t n = std::int64_t(m.size());
-  if (v_remap.size() != m.size()) v_remap.resize(m.size());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) v_remap[i].setZero();
+  clean_ = true;
 }
 
 template class UniformGrid<2>;

@@ -109,6 +109,9 @@ class UniformGrid {
   /// Slab layer (position along the slab axis within the window) of a key.
   int layer(std::int64_t key) const { return int(key / stride_[slab_]); }
   int layers() const { return hi_[slab_] - lo_[slab_] + 1; }
+  /// Node index distance between two slab layers: the nodes of layer l are
+  /// [l * layer_stride(), (l + 1) * layer_stride()).
+  std::int64_t layer_stride() const { return stride_[slab_]; }
   int slab_axis() const { return slab_; }
   /// Offset of corner c of a cell from its lower corner node.
   std::int64_t corner(int c) const { return corner_[c]; }
@@ -126,8 +129,9 @@ class UniformGrid {
   std::vector<Vec<D>> v_remap;  ///< MUSL: remapped momentum, then velocity
   std::vector<std::uint8_t> rigid;  ///< 1 + index of the rigid body touching the node, or 0
   /// Clears m, v and a (and v_remap when `remap`, rigid when `rigid_bodies`) over the window.
+  /// After the first clear following fit(), only nodes with mass are cleared: users must keep
+  /// v, a and v_remap zero at nodes without mass (the solver's grid kernels do).
   void clear(bool remap, bool rigid_bodies = false);
-  void clear_remap();
 
   // Boundary conditions --------------------------------------------------------------------
   /// A window node on a constrained face; face = 2 * axis + (0 for min, 1 for max).
@@ -152,6 +156,7 @@ class UniformGrid {
   std::array<std::int64_t, D> stride_{};
   std::array<std::int64_t, kCorners<D>> corner_{};
   int slab_ = D - 1;
+  bool clean_ = false;  ///< nodes without mass hold zeros everywhere
   std::vector<FaceNode> fixed_, slip_;
 };
 

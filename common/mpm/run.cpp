@@ -138,7 +138,12 @@ std::string run_info(const Scene& scene, const Lattice& lat, int threads) {
 template <int D>
 int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame& model) {
   const int threads = omp_get_max_threads();
-  UniformSolver<D> solver(scene, UniformGrid<D>(lattice, scene.boundary), model.columns);
+  const ScatterStrategy strategy = parse_strategy(opt.strategy, "--strategy");
+  if (opt.deterministic && strategy != ScatterStrategy::Colored)
+    throw InputError("--deterministic",
+                     "only the colored strategy gives results independent of the thread count "
+                     "(it is the default); drop --strategy " + opt.strategy);
+  UniformSolver<D> solver(scene, UniformGrid<D>(lattice, scene.boundary), model.columns, strategy);
   StreamWriter out(opt.output);
   out.write_text(RecordType::Scene, scene.toml);
   out.write_text(RecordType::Info, run_info(scene, lattice, threads));
@@ -244,17 +249,17 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
     const double wall = timers.total();
     std::fprintf(stderr, "\n%s", timers.table(ps).c_str());
     std::fprintf(stderr,
-                 "\nthreads %d, particles %zu, steps %ld, sorts %ld, particle-steps %.4g, "
-                 "%.3f million particle-steps/s\n",
-                 threads, solver.particles().size(), solver.steps(), solver.binning().sorts(), ps,
-                 wall > 0 ? ps / wall / 1e6 : 0.0);
+                 "\nstrategy %s, threads %d, particles %zu, steps %ld, sorts %ld, particle-steps "
+                 "%.4g, %.3f million particle-steps/s\n",
+                 to_string(solver.strategy()).c_str(), threads, solver.particles().size(),
+                 solver.steps(), solver.binning().sorts(), ps, wall > 0 ? ps / wall / 1e6 : 0.0);
     const double peak = peak_memory();
     std::fprintf(stderr,
                  "peak memory %.1f MB, %.0f bytes per particle (all of the process: particles, "
                  "grid window, sort scratch, the model as read); particle columns %zu bytes, grid "
-                 "window %zu nodes\n",
+                 "window %zu nodes, solver work arrays %.1f MB\n",
                  peak / 1e6, peak / double(std::max<std::size_t>(1, solver.particles().size())),
-                 solver.particles().element_bytes(), solver.grid().nodes());
+                 solver.particles().element_bytes(), solver.grid().nodes(), solver.work_bytes() / 1e6);
   }
   return status;
 }

@@ -13,6 +13,8 @@ struct RunOptions {
   int threads = 0;                       ///< OpenMP threads; 0: the OpenMP default
   std::vector<std::string> overrides;    ///< --set key=value
   bool stats = false;                    ///< print the kernel time table at the end
+  std::string strategy = "colored";      ///< particle-to-grid scatter strategy
+  bool deterministic = false;            ///< results independent of the thread count
   ProgressMode progress = ProgressMode::Auto;
 };
 

@@ -531,11 +531,13 @@ void read_eos(Reader& r, EosSpec& e) {
                  "model", {{"linear", EosModel::Linear}, {"mie-gruneisen", EosModel::MieGruneisen}})
                 .value_or(EosModel::Linear);
   if (e.model == EosModel::Linear) {
-    r.reject({"c0", "s", "gamma0"}, "by the linear model (set model = \"mie-gruneisen\")");
+    r.reject({"c0", "s", "gamma0", "energy_in_expansion"},
+             "by the linear model (set model = \"mie-gruneisen\")");
   } else {
     e.c0 = r.required("c0", dim::velocity, Bound::Positive, "3940 m/s");
     e.s = r.required("s", dim::none, Bound::NonNegative, "1.49");
     e.gamma0 = r.required("gamma0", dim::none, Bound::NonNegative, "1.96");
+    e.energy_in_expansion = r.boolean("energy_in_expansion").value_or(true);
   }
   r.finish();
 }
@@ -564,7 +566,8 @@ MaterialSpec read_material(Reader& r, const std::string& name) {
                         "melt_temperature", "specific_heat", "taylor_quinney"})) {
     read_strength(*t, m.strength);
   }
-  if (auto t = r.table("eos", {"model", "c0", "s", "gamma0"})) read_eos(*t, m.eos);
+  if (auto t = r.table("eos", {"model", "c0", "s", "gamma0", "energy_in_expansion"}))
+    read_eos(*t, m.eos);
   if (auto t = r.table("failure", {"plastic_strain", "pressure"})) read_failure(*t, m.failure);
   r.finish();
   return m;

@@ -43,6 +43,9 @@ struct EosSpec {
   double c0 = 0;      ///< bulk sound speed, m/s
   double s = 0;       ///< slope of the shock-particle velocity relation
   double gamma0 = 0;  ///< Grueneisen coefficient
+  /// Mie-Grueneisen in expansion (mu < 0): p = rho0 c0^2 mu + gamma0 E as 000 eq. 18 prints it
+  /// (true), or without the energy term, as the seed authors' own code does (false).
+  bool energy_in_expansion = true;
 };
 
 /// Failure: a failed particle keeps no deviatoric stress and carries no tension.

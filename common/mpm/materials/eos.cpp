@@ -32,7 +32,8 @@ class LinearEos final : public Eos {
 class MieGruneisenEos final : public Eos {
  public:
   explicit MieGruneisenEos(const MaterialSpec& m)
-      : rho0_(m.density), c0_(m.eos.c0), s_(m.eos.s), gamma0_(m.eos.gamma0) {
+      : rho0_(m.density), c0_(m.eos.c0), s_(m.eos.s), gamma0_(m.eos.gamma0),
+        energy_in_expansion_(m.eos.energy_in_expansion) {
     // The Hugoniot is singular at mu = 1/(s - 1); stop 5% short of it (compression ratios
     // beyond that are outside the fitted shock data anyway).
     mu_max_ = s_ > 1.0 ? 0.95 / (s_ - 1.0) : 1e9;
@@ -54,12 +55,14 @@ class MieGruneisenEos final : public Eos {
       } else {
         A[i] = k0 * mu;
         K[i] = k0 * std::max(1.0 + mu, 0.05);
+        if (!energy_in_expansion_) B[i] = 0.0;  // p = rho0 c0^2 mu only
       }
     }
   }
 
  private:
   double rho0_, c0_, s_, gamma0_, mu_max_;
+  bool energy_in_expansion_;
 };
 
 }  // namespace
