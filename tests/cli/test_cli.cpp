@@ -4,8 +4,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <cstring>
 #include <regex>
 
+#include "mpm/stream.hpp"
 #include "run_command.hpp"
 
 namespace mpm {
@@ -172,6 +174,53 @@ TEST(Cli, UnstableRunStopsAndKeepsItsFrames) {
   EXPECT_NE(r.out.find("status 3"), std::string::npos) << r.out;
   r = run(post + " history " + out.string() + " -o " + (dir / "h.csv").string(), dir);
   EXPECT_EQ(r.status, 3);  // the run's failure propagates to scripts
+}
+
+}  // namespace
+}  // namespace mpm
+
+namespace mpm {
+namespace {
+
+std::vector<Frame> frames_of(const std::string& path) {
+  std::vector<Frame> out;
+  StreamVisitor v;
+  v.frame = [&](Frame&& f) { out.push_back(std::move(f)); };
+  const StreamSummary s = read_stream(path, v);
+  EXPECT_TRUE(s.damage.empty()) << s.damage;
+  return out;
+}
+
+// The default strategy's frames are bitwise the same at 1 and 2 threads, through the tools;
+// --deterministic refuses strategies that cannot promise it.
+TEST(Cli, DeterministicFramesAtOneAndTwoThreads) {
+  const auto dir = mpm::testing::temp_dir("deterministic");
+  const std::string model = (dir / "model.mpm").string();
+  using mpm::testing::run;
+  ASSERT_EQ(run(mpm::testing::prep + " " + (std::filesystem::path(MPM_TEST_DATA) / "cli" / "block.toml").string() +
+                    " -o " + model,
+                dir).status,
+            0);
+  for (int t : {1, 2})
+    ASSERT_EQ(run(mpm::testing::runner + " " + model + " --deterministic --threads " + std::to_string(t) +
+                      " --progress none -o " + (dir / ("t" + std::to_string(t) + ".mpm")).string(),
+                  dir).status,
+              0);
+  const auto a = frames_of((dir / "t1.mpm").string()), b = frames_of((dir / "t2.mpm").string());
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_GT(a.size(), 2u);
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    ASSERT_EQ(a[k].columns.columns().size(), b[k].columns.columns().size());
+    for (const auto& c : a[k].columns.columns()) {
+      const Column& d = b[k].columns.at(c.info().name);
+      ASSERT_EQ(c.bytes(), d.bytes());
+      EXPECT_EQ(std::memcmp(c.data(), d.data(), c.bytes()), 0) << "frame " << k << " column " << c.info().name;
+    }
+  }
+  const auto r = run(mpm::testing::runner + " " + model + " --deterministic --strategy patch -o /dev/null", dir);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--deterministic"), std::string::npos) << r.err;
+  EXPECT_EQ(run(mpm::testing::runner + " " + model + " --strategy bogus -o /dev/null", dir).status, 2);
 }
 
 }  // namespace
