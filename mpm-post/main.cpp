@@ -68,6 +68,13 @@ std::string json_string(const std::string& s) {
   return o + "\"";
 }
 
+/// An axis option: "x", "y" or "z" to 0, 1, 2.
+int axis_of(const std::string& text) {
+  if (text != "x" && text != "y" && text != "z")
+    throw InputError("--axis", "expected x, y or z, got '" + text + "'");
+  return text[0] - 'x';
+}
+
 /// A command-line quantity: "16.2 mm", or a plain number in SI units (as in scene files).
 double quantity(const std::string& text, const Dimension& dim, const std::string& option) {
   try {
@@ -226,11 +233,7 @@ int cmd_taylor(const std::string& path, const TaylorArgs& a) {
   TaylorOptions opt;
   opt.body = a.body;
   opt.surface = a.surface;
-  if (!a.axis.empty()) {
-    if (a.axis != "x" && a.axis != "y" && a.axis != "z")
-      throw InputError("--axis", "expected x, y or z, got '" + a.axis + "'");
-    opt.axis = a.axis[0] - 'x';
-  }
+  if (!a.axis.empty()) opt.axis = axis_of(a.axis);
   if (!a.wall.empty()) opt.wall = quantity(a.wall, dim::length, "--wall");
   StreamVisitor v;
   v.scene = [&](const std::string& t) {
@@ -292,11 +295,7 @@ int cmd_debris(const std::string& path, const DebrisArgs& a) {
   opt.target = a.target;
   opt.projectile = a.projectile;
   opt.percentile = a.percentile;
-  if (!a.axis.empty()) {
-    if (a.axis != "x" && a.axis != "y" && a.axis != "z")
-      throw InputError("--axis", "expected x, y or z, got '" + a.axis + "'");
-    opt.axis = a.axis[0] - 'x';
-  }
+  if (!a.axis.empty()) opt.axis = axis_of(a.axis);
   if (!a.plane.empty()) opt.plane = quantity(a.plane, dim::length, "--plane");
   std::optional<double> at;
   if (!a.time.empty()) at = quantity(a.time, dim::time, "--time");

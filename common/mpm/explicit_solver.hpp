@@ -135,6 +135,7 @@ class ExplicitSolver {
   void grid_velocity();
   void grid_update(bool momentum_in_v);
   void grid_remap();
+  void momentum_to_velocity(std::vector<Vec<D>>& field);
   template <bool Remap, bool Move>
   void g2p();
   void update_stress(const std::vector<Vec<D>>& v_grad, bool move);

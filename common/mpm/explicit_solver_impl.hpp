@@ -570,16 +570,21 @@ void ExplicitSolver<GridT>::apply_boundary(std::vector<Vec<D>>& vel, std::vector
 }
 
 template <class GridT>
-void ExplicitSolver<GridT>::grid_velocity() {
-  ScopedTimer timer(timers_, timers_.id("grid_velocity"));
+void ExplicitSolver<GridT>::momentum_to_velocity(std::vector<Vec<D>>& field) {
   const std::int64_t n = std::int64_t(grid_.nodes());
   const double floor = node_mass_floor_;
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
-    if (grid_.m[i] > floor) grid_.v[i] /= grid_.m[i];
-    else if (!grid_.v[i].isZero()) grid_.v[i].setZero();  // keep empty nodes at zero
+    if (grid_.m[i] > floor) field[i] /= grid_.m[i];
+    else if (!field[i].isZero()) field[i].setZero();  // keep empty nodes at zero
   }
-  apply_boundary(grid_.v, nullptr, false);
+  apply_boundary(field, nullptr, false);
+}
+
+template <class GridT>
+void ExplicitSolver<GridT>::grid_velocity() {
+  ScopedTimer timer(timers_, timers_.id("grid_velocity"));
+  momentum_to_velocity(grid_.v);
 }
 
 template <class GridT>
@@ -606,14 +611,7 @@ void ExplicitSolver<GridT>::grid_update(bool momentum_in_v) {
 template <class GridT>
 void ExplicitSolver<GridT>::grid_remap() {
   ScopedTimer timer(timers_, timers_.id("grid_remap"));
-  const std::int64_t n = std::int64_t(grid_.nodes());
-  const double floor = node_mass_floor_;
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
-    if (grid_.m[i] > floor) grid_.v_remap[i] /= grid_.m[i];
-    else if (!grid_.v_remap[i].isZero()) grid_.v_remap[i].setZero();  // keep empty nodes at zero
-  }
-  apply_boundary(grid_.v_remap, nullptr, false);
+  momentum_to_velocity(grid_.v_remap);
 }
 
 // ------------------------------------------------------------------------------------------
