@@ -669,7 +669,8 @@ void ExplicitSolver<GridT>::update_stress(const std::vector<Vec<D>>& v_grad, boo
             if (axi) v_r += N[c] * vg[0];
             if (move) vbar += N[c] * (home ? v_c[c] : v_i[nd[c]]);
           }
-          if (int(p.material[i]) != mat || k == kBlock) {
+          // A block is a contiguous run of one material: a skipped rigid particle ends it.
+          if (int(p.material[i]) != mat || k == kBlock || i != i0 + std::uint32_t(k)) {
             flush();
             mat = p.material[i];
             i0 = i;
