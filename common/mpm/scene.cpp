@@ -879,7 +879,7 @@ void read_implicit(Reader& r, ImplicitSpec& m) {
   m.max_cuts = static_cast<int>(r.integer("max_cuts", 0, 60).value_or(10));
   m.forcing = r.choice<Forcing>("forcing", {{"fixed", Forcing::Fixed},
                                             {"eisenstat-walker", Forcing::EisenstatWalker}})
-                  .value_or(Forcing::Fixed);
+                  .value_or(Forcing::EisenstatWalker);
   m.preconditioner = r.choice<Preconditioner>("preconditioner", {{"none", Preconditioner::None},
                                                                   {"diagonal", Preconditioner::Diagonal}})
                          .value_or(Preconditioner::Diagonal);

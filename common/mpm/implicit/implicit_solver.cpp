@@ -215,11 +215,17 @@ double ImplicitSolver<GridT>::residual_scale(double dt) const {
   return youngs_max_ * cell_measure_ * dt;  // Y dx dy dt (001, section 3.2.2)
 }
 
+/// Below this many particles the kernels run on one thread: a residual evaluation of a small
+/// 2D scene takes microseconds, less than waking the OpenMP team (much less on a loaded
+/// machine), and a Newton-Krylov step makes dozens of them.
+inline constexpr std::size_t kParallelParticles = 4096;
+
 template <class GridT>
 template <class F>
 void ImplicitSolver<GridT>::for_chunks(F&& body) {
   const int n = binning_.chunk_count();
-#pragma omp parallel for schedule(dynamic, 1)
+  const bool parallel = particles_.size() >= kParallelParticles;
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
   for (int ch = 0; ch < n; ++ch) body(ch);
 }
 
@@ -229,8 +235,9 @@ template <class GridT>
 template <class F>
 void ImplicitSolver<GridT>::for_chunks_coloured(F&& body) {
   const int n = binning_.chunk_count();
+  const bool parallel = particles_.size() >= kParallelParticles;
   for (int colour = 0; colour < 2; ++colour) {
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
     for (int ch = colour; ch < n; ch += 2) body(ch);
   }
 }
@@ -349,10 +356,12 @@ void ImplicitSolver<GridT>::free_dofs() {
   v_bc_.assign(nodes, Vec<D>::Zero());
   for (const auto& f : grid_.fixed_nodes()) held_[f.node] = all;
   for (const auto& f : grid_.slip_nodes()) held_[f.node] |= std::uint8_t(1u << (f.face / 2));
+  face_held_ = held_;
   if (has_rigid_)
     for (std::size_t n = 0; n < nodes; ++n)
       if (grid_.rigid[n] && grid_.m[n] > node_mass_floor_) {
         held_[n] = all;
+        face_held_[n] = 0;
         v_bc_[n] = rigid_velocity_[grid_.rigid[n] - 1];
       }
   dof_node_.clear();
@@ -475,6 +484,8 @@ void ImplicitSolver<GridT>::to_grid(const nk::Vector& u, std::vector<Vec<D>>& w)
 /// Momentum formulation: particle velocities from the grid momenta (001, eq. 3.2.6,
 /// v_p^L = v_p^k + sum_i N_ip (P_i^L - P_i^k) / m_i), then the Lagrangian grid velocity from
 /// them by the least squares of the start of the step (eq. 3.2.7), with the prescribed values.
+/// As in the explicit solver, a wall (fixed or slip face) holds the grid velocity but gives
+/// the particles no increment (its acceleration is zero); a rigid body's nodes do.
 template <class GridT>
 void ImplicitSolver<GridT>::remap_trial(const std::vector<Vec<D>>& P_L, Trial& t) {
   ScopedTimer timer(timers_, timers_.id("remap_trial"));
@@ -493,7 +504,7 @@ void ImplicitSolver<GridT>::remap_trial(const std::vector<Vec<D>>& P_L, Trial& t
         const double* N = &N_p_[i * NMAX];
         Vec<D> v = p.v[i];
         for (int c = 0; c < nn; ++c)
-          if (grid_.m[nd[c]] > floor) v += N[c] * (P_L[nd[c]] - P_k_[nd[c]]) / grid_.m[nd[c]];
+          if (grid_.m[nd[c]] > floor) v += N[c] * increment(nd[c], P_L[nd[c]] - P_k_[nd[c]]) / grid_.m[nd[c]];
         t.v_p[i] = v;
         const Vec<D> mv = p.m[i] * v;
         for (int c = 0; c < nn; ++c) q[nd[c]] += N[c] * mv;
@@ -760,7 +771,8 @@ void ImplicitSolver<GridT>::commit(const nk::Vector& u) {
           Vec<D> vbar = Vec<D>::Zero(), dv = Vec<D>::Zero();
           for (int c = 0; c < nn; ++c) {
             vbar += N[c] * v_move[nd[c]];
-            if (!momentum && grid_.m[nd[c]] > floor) dv += N[c] * (v_L[nd[c]] - v_k_[nd[c]]);
+            if (!momentum && grid_.m[nd[c]] > floor)
+              dv += N[c] * increment(nd[c], v_L[nd[c]] - v_k_[nd[c]]);
           }
           p.v[i] = momentum ? t.v_p[i] : Vec<D>(p.v[i] + dv);
           p.x[i] += dt * vbar;

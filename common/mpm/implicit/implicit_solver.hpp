@@ -125,6 +125,13 @@ class ImplicitSolver {
   void for_chunks_coloured(F&& body);
   void move_velocity(const nk::Vector& u, std::vector<Vec<D>>& v_move) const;
   bool rigid(std::uint32_t i) const { return material_[i] == kRigidMaterial; }
+  /// A node's velocity (or momentum) change as the particles get it: zero in the components a
+  /// wall holds (the explicit solver's convention: a wall's acceleration is zero).
+  Vec<D> increment(std::int64_t n, Vec<D> d) const {
+    for (int a = 0; a < D; ++a)
+      if (face_held_[n] >> a & 1) d[a] = 0;
+    return d;
+  }
 
   Scene scene_;
   ImplicitSpec spec_;
@@ -157,6 +164,7 @@ class ImplicitSolver {
   std::vector<Vec<D>> f_ext_;    ///< body forces and loads
   std::vector<Vec<D>> k_diag_;   ///< diagonal of the elastic stiffness, N/m
   std::vector<std::uint8_t> held_;  ///< bit a: component a is prescribed (Dirichlet)
+  std::vector<std::uint8_t> face_held_;  ///< bit a: ... by a wall (not a rigid body)
   std::vector<Vec<D>> v_bc_;     ///< prescribed velocities
   std::vector<std::int64_t> dof_node_;  ///< unknown -> node
   std::vector<int> dof_axis_;           ///< unknown -> component
