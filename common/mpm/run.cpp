@@ -212,6 +212,7 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
   int status = kExitOk;
   std::string message;
   const long max_steps = scene.solver.max_steps;
+  const double loop_start = omp_get_wtime();
   try {
     while (solver.time() < end * (1 - 1e-12)) {
       if (g_signal) {
@@ -260,6 +261,7 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
     status = kExitUnstable;
     message = e.what();
   }
+  const double loop_wall = omp_get_wtime() - loop_start;  // the time loop, output included
   history.flush(out);
   out.write_end(status, message);
   out.close();
@@ -295,11 +297,12 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
       std::fprintf(stderr,
                    "implicit: explicit dt %.6g s, steps %ld, newton %ld, krylov %ld, residual "
                    "evaluations %ld, line-search cuts %ld, step cuts %ld (lagrangian %ld), wall "
-                   "%.4f s\n",
+                   "%.4f s (time loop)\n",
                    solver.explicit_dt(), w.steps, w.newton, w.krylov, w.evaluations,
-                   w.line_search_cuts, w.step_cuts, w.lagrangian_cuts, wall);
+                   w.line_search_cuts, w.step_cuts, w.lagrangian_cuts, loop_wall);
     } else {
-      std::fprintf(stderr, "explicit: steps %ld, wall %.4f s\n", solver.steps(), wall);
+      std::fprintf(stderr, "explicit: steps %ld, wall %.4f s (time loop)\n", solver.steps(),
+                   loop_wall);
     }
   }
   return status;

@@ -882,7 +882,8 @@ void read_implicit(Reader& r, ImplicitSpec& m) {
                   .value_or(Forcing::EisenstatWalker);
   m.preconditioner = r.choice<Preconditioner>("preconditioner", {{"none", Preconditioner::None},
                                                                   {"diagonal", Preconditioner::Diagonal}})
-                         .value_or(Preconditioner::Diagonal);
+                         .value_or(m.formulation == Formulation::Velocity ? Preconditioner::Diagonal
+                                                                          : Preconditioner::None);
   r.finish();
 }
 
@@ -1012,9 +1013,9 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
   }
   {
     Reader v = top.required_table("solver",
-                                  {"type", "implicit", "scheme", "cfl", "end_time", "dt_max",
-                                   "gravity", "on_exit", "energy_growth_limit", "max_steps",
-                                   "bulk_viscosity"},
+                                  {"scheme", "cfl", "end_time", "dt_max", "gravity", "on_exit",
+                                   "energy_growth_limit", "max_steps", "bulk_viscosity", "type",
+                                   "implicit"},
                                   "end_time is required");
     read_solver(v, s);
   }

@@ -155,7 +155,9 @@ struct ImplicitSpec {
   double cut = 0.5;                   ///< factor on the step after a failed Newton solve
   int max_cuts = 10;                  ///< cuts of one step before the run stops (exit 3)
   Forcing forcing = Forcing::EisenstatWalker;  ///< measured to win: examples/implicit/results.md
-  Preconditioner preconditioner = Preconditioner::Diagonal;  ///< the same
+  /// Default by measurement too: diagonal for the velocity formulation (CG), none for the
+  /// momentum formulation (GMRES), where the elastic diagonal slowed the plastic upsetting.
+  Preconditioner preconditioner = Preconditioner::None;
 };
 
 struct SolverSpec {

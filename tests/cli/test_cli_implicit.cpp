@@ -20,7 +20,7 @@ TEST(CliImplicit, RunsAndWritesItsWorkToTheHistory) {
   const auto dir = temp_dir("implicit_run");
   const fs::path out = dir / "run.mpm";
   Result r = run(prep + " " + kBlock.string() + " | " + runner +
-                     " --progress none --stats --set solver.type=implicit -o " + out.string(),
+                     " --threads 1 --progress none --stats --set solver.type=implicit -o " + out.string(),
                  dir);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("implicit: explicit dt"), std::string::npos) << r.err;
@@ -71,7 +71,7 @@ TEST(CliImplicit, NewtonFailureStopsTheRunAndKeepsItsFrames) {
   Result r = run(prep + " " + kBlock.string() +
                      " --set bodies.block.translate=\"0 0 4 mm\" --set solver.end_time=\"40 us\"" +
                      " --set output.frames=40 | " + runner +
-                     " --progress none --set solver.type=implicit" +
+                     " --threads 1 --progress none --set solver.type=implicit" +
                      " --set solver.implicit.max_newton=1 --set solver.implicit.newton_tolerance=1e-10" +
                      " --set solver.implicit.max_cuts=2 --set solver.implicit.dt_target_multiple=10" +
                      " -o " + out.string(),
@@ -89,7 +89,7 @@ TEST(CliImplicit, NewtonFailureStopsTheRunAndKeepsItsFrames) {
 TEST(CliImplicit, PostParticlesWritesCsv) {
   const auto dir = temp_dir("post_particles");
   const fs::path out = dir / "run.mpm";
-  Result r = run(prep + " " + kBlock.string() + " | " + runner + " --progress none -o " + out.string(), dir);
+  Result r = run(prep + " " + kBlock.string() + " | " + runner + " --threads 1 --progress none -o " + out.string(), dir);
   ASSERT_EQ(r.status, 0) << r.err;
   r = run(post + " particles " + out.string() + " --columns id,x,sigma --frame 0", dir);
   ASSERT_EQ(r.status, 0) << r.err;

@@ -62,6 +62,8 @@ Scene implicit(Scene s, Formulation f, double theta = 1.0) {
   s.solver.type = SolverType::Implicit;
   s.solver.implicit.formulation = f;
   s.solver.implicit.krylov = f == Formulation::Velocity ? KrylovMethod::CG : KrylovMethod::GMRES;
+  s.solver.implicit.preconditioner =  // the scene's defaults
+      f == Formulation::Velocity ? Preconditioner::Diagonal : Preconditioner::None;
   s.solver.implicit.theta = theta;
   return s;
 }
