@@ -636,7 +636,7 @@ void ImplicitSolver<GridT>::force_trial(Trial& t) {
 /// Y dx dy dt (section 3.2.2).
 template <class GridT>
 void ImplicitSolver<GridT>::residual(const nk::Vector& u, const Trial& t, nk::Vector& F) const {
-  ScopedTimer timer(const_cast<KernelTimers&>(timers_), const_cast<KernelTimers&>(timers_).id("residual"));
+  ScopedTimer timer(timers_, timers_.id("residual"));
   const bool momentum = spec_.formulation == Formulation::Momentum;
   const double dt = dt_, th = spec_.theta, inv_scale = 1.0 / residual_scale(dt_);
   F.resize(u.size());
@@ -668,8 +668,7 @@ void ImplicitSolver<GridT>::move_velocity(const nk::Vector& u, std::vector<Vec<D
 /// positive (001, section 3.2.7).
 template <class GridT>
 bool ImplicitSolver<GridT>::folds(const std::vector<Vec<D>>& v) const {
-  ScopedTimer timer(const_cast<KernelTimers&>(timers_),
-                    const_cast<KernelTimers&>(timers_).id("lagrangian_check"));
+  ScopedTimer timer(timers_, timers_.id("lagrangian_check"));
   const double h = grid_.min_cell_size(), dt = dt_;
   for (const Bin& bin : binning_.bins()) {
     bool material = false;

@@ -179,7 +179,7 @@ class ImplicitSolver {
 
   ImplicitWork work_, last_work_;
   std::vector<double> last_residuals_;
-  KernelTimers timers_;
+  mutable KernelTimers timers_;  ///< const kernels (residual, fold check) are timed too
 };
 
 }  // namespace mpm
