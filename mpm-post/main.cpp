@@ -287,12 +287,18 @@ double column_value(const Column& c, std::size_t i, int k) {
   const std::size_t at = i * std::size_t(c.info().components) + std::size_t(k);
   const std::byte* d = c.data();
   switch (c.info().type) {
-    case ScalarType::F64: return reinterpret_cast<const double*>(d)[at];
-    case ScalarType::F32: return reinterpret_cast<const float*>(d)[at];
-    case ScalarType::U8: return double(reinterpret_cast<const std::uint8_t*>(d)[at]);
-    case ScalarType::U32: return double(reinterpret_cast<const std::uint32_t*>(d)[at]);
-    case ScalarType::I32: return double(reinterpret_cast<const std::int32_t*>(d)[at]);
-    case ScalarType::U64: return double(reinterpret_cast<const std::uint64_t*>(d)[at]);
+    case ScalarType::F64:
+      return reinterpret_cast<const double*>(d)[at];
+    case ScalarType::F32:
+      return reinterpret_cast<const float*>(d)[at];
+    case ScalarType::U8:
+      return double(reinterpret_cast<const std::uint8_t*>(d)[at]);
+    case ScalarType::U32:
+      return double(reinterpret_cast<const std::uint32_t*>(d)[at]);
+    case ScalarType::I32:
+      return double(reinterpret_cast<const std::int32_t*>(d)[at]);
+    case ScalarType::U64:
+      return double(reinterpret_cast<const std::uint64_t*>(d)[at]);
   }
   return NAN;
 }
@@ -328,8 +334,10 @@ int cmd_particles(const std::string& path, const std::string& out, const std::st
       const Column* c = chosen->columns.find(name);
       if (!c) {
         std::string known;
-        for (const auto& k : chosen->columns.columns()) known += (known.empty() ? "" : ", ") + k.info().name;
-        throw InputError("--columns", "unknown particle column '" + name + "' (known: " + known + ")");
+        for (const auto& k : chosen->columns.columns())
+          known += (known.empty() ? "" : ", ") + k.info().name;
+        throw InputError("--columns",
+                         "unknown particle column '" + name + "' (known: " + known + ")");
       }
       picked.push_back(c);
     }
@@ -354,8 +362,10 @@ int cmd_particles(const std::string& path, const std::string& out, const std::st
       }
     std::fprintf(f, "\n");
   }
-  if (f != stdout) std::fclose(f);
-  else std::fflush(stdout);
+  if (f != stdout)
+    std::fclose(f);
+  else
+    std::fflush(stdout);
   return conclude(path, s, std::size_t(index));
 }
 
@@ -431,13 +441,16 @@ int main(int argc, char** argv) {
   history->add_option("-o,--output", hist_out, "CSV file, - for stdout")->capture_default_str();
   history->add_option("--columns", hist_cols, "columns to print (default all)")->delimiter(',');
 
-  auto* particles = app.add_subcommand("particles", "the particles of one frame as CSV (one column per component)");
+  auto* particles = app.add_subcommand(
+      "particles", "the particles of one frame as CSV (one column per component)");
   std::string part_out = "-", part_frame = "last";
   std::vector<std::string> part_cols;
   particles->add_option("input", input, "stream, - for stdin")->capture_default_str();
   particles->add_option("-o,--output", part_out, "CSV file, - for stdout")->capture_default_str();
-  particles->add_option("--frame", part_frame, "frame index (0 = first) or 'last'")->capture_default_str();
-  particles->add_option("--columns", part_cols, "particle columns (default all), e.g. x,sigma")->delimiter(',');
+  particles->add_option("--frame", part_frame, "frame index (0 = first) or 'last'")
+      ->capture_default_str();
+  particles->add_option("--columns", part_cols, "particle columns (default all), e.g. x,sigma")
+      ->delimiter(',');
 
   auto* vtk = app.add_subcommand("vtk", "ParaView files: a .vtu per frame and a .pvd series");
   std::string vtk_dir = "vtk", vtk_name = "frame";

@@ -109,8 +109,7 @@ int prepare_model(const PrepOptions& opt) {
       std::fprintf(stderr, "  %-14s %-12s %12zu %7s mm %14.6g %14.6g %7.2f%%\n", r.name.c_str(),
                    scene.bodies[b].rigid ? "(rigid)"
                                          : scene.materials[scene.bodies[b].material].name.c_str(),
-                   r.particles,
-                   mm(r.spacing).c_str(), r.mass, r.exact_mass,
+                   r.particles, mm(r.spacing).c_str(), r.mass, r.exact_mass,
                    r.exact_mass > 0 ? 100.0 * (r.mass - r.exact_mass) / r.exact_mass : 0.0);
       if (r.skipped_overlap > 0)
         std::fprintf(stderr, "  (body '%s': %zu points inside earlier bodies were not created)\n",

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
 #include <sstream>
 
 #include "mpm/error.hpp"
@@ -14,8 +15,6 @@
 #include "mpm/lattice.hpp"
 #include "mpm/stream.hpp"
 #include "mpm/version.hpp"
-
-#include <fstream>
 
 namespace mpm {
 
@@ -129,12 +128,12 @@ class History {
       for (int a = 0; a < dim_; ++a) row.push_back(factor_ * s.rigid_force()[b][a]);
     if constexpr (HasImplicitWork<Solver>) {
       const ImplicitWork& w = s.work();
-      row.insert(row.end(), {dt / s.explicit_dt(), double(w.newton - last_.newton),
-                             double(w.krylov - last_.krylov),
-                             double(w.evaluations - last_.evaluations),
-                             double(w.line_search_cuts - last_.line_search_cuts),
-                             double(w.step_cuts - last_.step_cuts), double(w.newton),
-                             double(w.krylov), double(w.evaluations)});
+      row.insert(row.end(),
+                 {dt / s.explicit_dt(), double(w.newton - last_.newton),
+                  double(w.krylov - last_.krylov), double(w.evaluations - last_.evaluations),
+                  double(w.line_search_cuts - last_.line_search_cuts),
+                  double(w.step_cuts - last_.step_cuts), double(w.newton), double(w.krylov),
+                  double(w.evaluations)});
       last_ = w;
     }
     block_.values.insert(block_.values.end(), row.begin(), row.end());

@@ -853,8 +853,9 @@ void read_implicit(Reader& r, ImplicitSpec& m) {
                       .value_or(Formulation::Momentum);
   const KrylovMethod natural =
       m.formulation == Formulation::Velocity ? KrylovMethod::CG : KrylovMethod::GMRES;
-  m.krylov = r.choice<KrylovMethod>("krylov", {{"cg", KrylovMethod::CG}, {"gmres", KrylovMethod::GMRES}})
-                 .value_or(natural);
+  m.krylov =
+      r.choice<KrylovMethod>("krylov", {{"cg", KrylovMethod::CG}, {"gmres", KrylovMethod::GMRES}})
+          .value_or(natural);
   if (m.krylov == KrylovMethod::CG && m.formulation == Formulation::Momentum)
     r.fail("krylov",
            "CG needs a symmetric Jacobian, and the momentum formulation's is not (001, section "
@@ -880,8 +881,9 @@ void read_implicit(Reader& r, ImplicitSpec& m) {
   m.forcing = r.choice<Forcing>("forcing", {{"fixed", Forcing::Fixed},
                                             {"eisenstat-walker", Forcing::EisenstatWalker}})
                   .value_or(Forcing::EisenstatWalker);
-  m.preconditioner = r.choice<Preconditioner>("preconditioner", {{"none", Preconditioner::None},
-                                                                  {"diagonal", Preconditioner::Diagonal}})
+  m.preconditioner = r.choice<Preconditioner>(
+                          "preconditioner",
+                          {{"none", Preconditioner::None}, {"diagonal", Preconditioner::Diagonal}})
                          .value_or(m.formulation == Formulation::Velocity ? Preconditioner::Diagonal
                                                                           : Preconditioner::None);
   r.finish();
@@ -889,15 +891,14 @@ void read_implicit(Reader& r, ImplicitSpec& m) {
 
 void read_solver(Reader& r, Scene& s) {
   SolverSpec& v = s.solver;
-  v.type = r.choice<SolverType>("type", {{"explicit", SolverType::Explicit},
-                                         {"implicit", SolverType::Implicit}})
+  v.type = r.choice<SolverType>(
+                "type", {{"explicit", SolverType::Explicit}, {"implicit", SolverType::Implicit}})
                .value_or(SolverType::Explicit);
-  if (auto t = r.table("implicit", {"theta", "formulation", "krylov", "newton_tolerance",
-                                    "linear_tolerance", "derivative_step", "gmres_basis",
-                                    "gmres_restarts", "max_krylov", "max_newton",
-                                    "max_line_search", "dt_initial_multiple",
-                                    "dt_target_multiple", "ramp", "cut", "max_cuts", "forcing",
-                                    "preconditioner"})) {
+  if (auto t = r.table(
+          "implicit", {"theta", "formulation", "krylov", "newton_tolerance", "linear_tolerance",
+                       "derivative_step", "gmres_basis", "gmres_restarts", "max_krylov",
+                       "max_newton", "max_line_search", "dt_initial_multiple", "dt_target_multiple",
+                       "ramp", "cut", "max_cuts", "forcing", "preconditioner"})) {
     if (v.type != SolverType::Implicit)
       r.fail("implicit", "is used only with solver.type = \"implicit\"");
     read_implicit(*t, v.implicit);
@@ -1012,11 +1013,11 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
     read_boundary(*b, s);
   }
   {
-    Reader v = top.required_table("solver",
-                                  {"scheme", "cfl", "end_time", "dt_max", "gravity", "on_exit",
-                                   "energy_growth_limit", "max_steps", "bulk_viscosity", "type",
-                                   "implicit"},
-                                  "end_time is required");
+    Reader v = top.required_table(
+        "solver",
+        {"scheme", "cfl", "end_time", "dt_max", "gravity", "on_exit", "energy_growth_limit",
+         "max_steps", "bulk_viscosity", "type", "implicit"},
+        "end_time is required");
     read_solver(v, s);
   }
   if (auto o = top.table("output", {"frames", "history_interval", "fields", "precision"})) {

@@ -138,7 +138,7 @@ enum class Preconditioner { None, Diagonal };
 /// The implicit solver (001, sections 2.4 and 3.2): the theta-scheme of eq. 2.4.1 solved by
 /// matrix-free Newton-Krylov with a backtracking line search. Defaults are the seed's.
 struct ImplicitSpec {
-  double theta = 1.0;                 ///< mu of (001, eq. 2.4.1): 0 explicit, 1 fully implicit
+  double theta = 1.0;  ///< mu of (001, eq. 2.4.1): 0 explicit, 1 fully implicit
   Formulation formulation = Formulation::Momentum;
   KrylovMethod krylov = KrylovMethod::GMRES;  ///< default: CG for velocity, GMRES for momentum
   double newton_tolerance = 1e-5;     ///< on ||F||_2 of the dimensionless residual (001 s. 3.2.2)
@@ -162,7 +162,7 @@ struct ImplicitSpec {
 
 struct SolverSpec {
   SolverType type = SolverType::Explicit;
-  ImplicitSpec implicit;              ///< used when type is Implicit
+  ImplicitSpec implicit;  ///< used when type is Implicit
   Scheme scheme = Scheme::MUSL;
   double cfl = 0.5;                   ///< dt = cfl * h / max(c + |v|)
   double end_time = 0;                ///< s

@@ -19,9 +19,10 @@ const fs::path kBlock = fs::path(MPM_TEST_DATA) / "cli" / "block.toml";
 TEST(CliImplicit, RunsAndWritesItsWorkToTheHistory) {
   const auto dir = temp_dir("implicit_run");
   const fs::path out = dir / "run.mpm";
-  Result r = run(prep + " " + kBlock.string() + " | " + runner +
-                     " --threads 1 --progress none --stats --set solver.type=implicit -o " + out.string(),
-                 dir);
+  Result r =
+      run(prep + " " + kBlock.string() + " | " + runner +
+              " --threads 1 --progress none --stats --set solver.type=implicit -o " + out.string(),
+          dir);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("implicit: explicit dt"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("stress_trial"), std::string::npos) << "kernel timers" << r.err;
@@ -56,7 +57,8 @@ TEST(CliImplicit, BadKeysAreInputErrors) {
                      " --set solver.type=implicit --set solver.implicit.theta=2 >/dev/null",
                  dir);
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("--set solver.implicit.theta: must be between 0"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--set solver.implicit.theta: must be between 0"), std::string::npos)
+      << r.err;
   r = run(prep + " " + kBlock.string() + " --set solver.implicit.theta=0.5 >/dev/null", dir);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("is used only with solver.type = \"implicit\""), std::string::npos) << r.err;
@@ -68,14 +70,15 @@ TEST(CliImplicit, BadKeysAreInputErrors) {
 TEST(CliImplicit, NewtonFailureStopsTheRunAndKeepsItsFrames) {
   const auto dir = temp_dir("implicit_fail");
   const fs::path out = dir / "run.mpm";
-  Result r = run(prep + " " + kBlock.string() +
-                     " --set bodies.block.translate=\"0 0 4 mm\" --set solver.end_time=\"40 us\"" +
-                     " --set output.frames=40 | " + runner +
-                     " --threads 1 --progress none --set solver.type=implicit" +
-                     " --set solver.implicit.max_newton=1 --set solver.implicit.newton_tolerance=1e-10" +
-                     " --set solver.implicit.max_cuts=2 --set solver.implicit.dt_target_multiple=10" +
-                     " -o " + out.string(),
-                 dir);
+  Result r =
+      run(prep + " " + kBlock.string() +
+              " --set bodies.block.translate=\"0 0 4 mm\" --set solver.end_time=\"40 us\"" +
+              " --set output.frames=40 | " + runner +
+              " --threads 1 --progress none --set solver.type=implicit" +
+              " --set solver.implicit.max_newton=1 --set solver.implicit.newton_tolerance=1e-10" +
+              " --set solver.implicit.max_cuts=2 --set solver.implicit.dt_target_multiple=10" +
+              " -o " + out.string(),
+          dir);
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_NE(r.err.find("did not converge after 2 cuts"), std::string::npos) << r.err;
   r = run(post + " summary " + out.string() + " --json", dir);
@@ -89,7 +92,9 @@ TEST(CliImplicit, NewtonFailureStopsTheRunAndKeepsItsFrames) {
 TEST(CliImplicit, PostParticlesWritesCsv) {
   const auto dir = temp_dir("post_particles");
   const fs::path out = dir / "run.mpm";
-  Result r = run(prep + " " + kBlock.string() + " | " + runner + " --threads 1 --progress none -o " + out.string(), dir);
+  Result r = run(prep + " " + kBlock.string() + " | " + runner +
+                     " --threads 1 --progress none -o " + out.string(),
+                 dir);
   ASSERT_EQ(r.status, 0) << r.err;
   r = run(post + " particles " + out.string() + " --columns id,x,sigma --frame 0", dir);
   ASSERT_EQ(r.status, 0) << r.err;

@@ -2,12 +2,12 @@
 // against analytic values or the explicit solver's (reference values and tolerances, with
 // where they come from, in implicit_v7.toml).
 #include <gtest/gtest.h>
+#include <toml++/toml.h>
 
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <sstream>
-#include <toml++/toml.h>
 
 #include "cli/run_command.hpp"
 
@@ -34,7 +34,8 @@ std::vector<std::map<std::string, double>> csv(const std::string& text) {
       continue;
     }
     std::map<std::string, double> row;
-    for (std::size_t k = 0; k < cells.size() && k < names.size(); ++k) row[names[k]] = std::stod(cells[k]);
+    for (std::size_t k = 0; k < cells.size() && k < names.size(); ++k)
+      row[names[k]] = std::stod(cells[k]);
     rows.push_back(row);
   }
   return rows;
@@ -66,7 +67,8 @@ Case run_case(const std::string& name) {
 
 /// The deformable particles of the last frame.
 std::vector<std::map<std::string, double>> material(const Case& c) {
-  const Result r = run(post + " particles " + c.stream.string() + " --columns x,sigma,material", c.dir);
+  const Result r =
+      run(post + " particles " + c.stream.string() + " --columns x,sigma,material", c.dir);
   EXPECT_EQ(r.status, 0) << r.err;
   auto rows = csv(r.out);
   std::erase_if(rows, [](auto& p) { return p["material"] == 255; });
@@ -88,8 +90,12 @@ void bar(const std::string& name) {
   EXPECT_LT((hi - lo) / mean, c.ref["spread"].value_or(0.0)) << "uniform along the bar";
 }
 
-TEST(RegressionImplicit, ElasticBarV7) { bar("elastic_bar"); }
-TEST(RegressionImplicit, PlasticBarV7) { bar("plastic_bar"); }
+TEST(RegressionImplicit, ElasticBarV7) {
+  bar("elastic_bar");
+}
+TEST(RegressionImplicit, PlasticBarV7) {
+  bar("plastic_bar");
+}
 
 TEST(RegressionImplicit, CollidingDisksV7) {
   const Case c = run_case("disks");
@@ -109,7 +115,8 @@ TEST(RegressionImplicit, UpsettingV7) {
   const double r_ref = c.ref["r_max"].value_or(0.0);
   EXPECT_NEAR(r_max, r_ref, c.ref["r_tolerance"].value_or(0.0) * r_ref);
   // Load: time-weighted mean over the last 0.5 mm of platen travel (1 m/s: the last 0.5 ms).
-  const Result r = run(post + " history " + c.stream.string() + " --columns time,dt,force_platen_y", c.dir);
+  const Result r =
+      run(post + " history " + c.stream.string() + " --columns time,dt,force_platen_y", c.dir);
   ASSERT_EQ(r.status, 0) << r.err;
   const auto rows = csv(r.out);
   const double t_end = rows.back().at("time");

@@ -199,7 +199,8 @@ TEST(Newton, InadmissibleStartIsReported) {
     bool evaluate(const Vector&, Vector&) override { return false; }
   } sys;
   Vector u = Vector::Zero(3);
-  EXPECT_EQ(nk::solve(sys, u, nk::Settings{}, nullptr, 0.0).outcome, nk::Outcome::InadmissibleStart);
+  EXPECT_EQ(nk::solve(sys, u, nk::Settings{}, nullptr, 0.0).outcome,
+            nk::Outcome::InadmissibleStart);
 }
 
 TEST(Newton, EisenstatWalkerSavesKrylovIterations) {

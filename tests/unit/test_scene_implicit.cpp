@@ -52,17 +52,17 @@ TEST(SceneImplicit, DefaultsAreTheSeeds) {
   s = parse("type = \"implicit\"\n");
   EXPECT_EQ(s.solver.type, SolverType::Implicit);
   const ImplicitSpec& m = s.solver.implicit;
-  EXPECT_EQ(m.theta, 1.0);                        // 001 section 3: fully implicit
+  EXPECT_EQ(m.theta, 1.0);                          // 001 section 3: fully implicit
   EXPECT_EQ(m.formulation, Formulation::Momentum);  // section 3.2: the robust one
   EXPECT_EQ(m.krylov, KrylovMethod::GMRES);
-  EXPECT_EQ(m.newton_tolerance, 1e-5);            // sections 3.1.1, 3.2.5
+  EXPECT_EQ(m.newton_tolerance, 1e-5);  // sections 3.1.1, 3.2.5
   EXPECT_EQ(m.linear_tolerance, 1e-3);
-  EXPECT_EQ(m.derivative_step, 1e-5);             // section 3.2.2
-  EXPECT_EQ(m.gmres_basis, 20);                   // section 3.2.4
-  EXPECT_EQ(m.ramp, 0.2);                         // Tables 1-6: 20% a step
+  EXPECT_EQ(m.derivative_step, 1e-5);  // section 3.2.2
+  EXPECT_EQ(m.gmres_basis, 20);        // section 3.2.4
+  EXPECT_EQ(m.ramp, 0.2);              // Tables 1-6: 20% a step
   EXPECT_EQ(m.dt_initial_multiple, 1.0);
-  EXPECT_EQ(m.forcing, Forcing::EisenstatWalker);        // beyond the seed: measured to win
-  EXPECT_EQ(m.preconditioner, Preconditioner::None);      // with GMRES: measured to lose
+  EXPECT_EQ(m.forcing, Forcing::EisenstatWalker);     // beyond the seed: measured to win
+  EXPECT_EQ(m.preconditioner, Preconditioner::None);  // with GMRES: measured to lose
   const Scene v = parse("type = \"implicit\"\n", {"solver.implicit.formulation=velocity"});
   EXPECT_EQ(v.solver.implicit.krylov, KrylovMethod::CG);
   EXPECT_EQ(v.solver.implicit.preconditioner, Preconditioner::Diagonal);  // with CG: wins
@@ -109,8 +109,8 @@ preconditioner = "none"
   EXPECT_EQ(m.forcing, Forcing::Fixed);
   EXPECT_EQ(m.preconditioner, Preconditioner::None);
   // Velocity formulation with GMRES is allowed; --set reaches the table.
-  const Scene g = parse("type = \"implicit\"\n", {"solver.implicit.formulation=velocity",
-                                                  "solver.implicit.krylov=gmres"});
+  const Scene g = parse("type = \"implicit\"\n",
+                        {"solver.implicit.formulation=velocity", "solver.implicit.krylov=gmres"});
   EXPECT_EQ(g.solver.implicit.krylov, KrylovMethod::GMRES);
 }
 

@@ -94,8 +94,8 @@ TEST(Implicit, MatrixFreeProductMatchesFiniteDifferenceJacobian) {
   for (Formulation f : {Formulation::Velocity, Formulation::Momentum}) {
     SCOPED_TRACE(f == Formulation::Velocity ? "velocity" : "momentum");
     Model m = pulled_bar(0.002);
-    ImplicitSolver<UniformGrid<2>> solver(implicit(m.scene, f), UniformGrid<2>(m.lat, m.scene.boundary),
-                                          m.cols);
+    ImplicitSolver<UniformGrid<2>> solver(implicit(m.scene, f),
+                                          UniformGrid<2>(m.lat, m.scene.boundary), m.cols);
     const double dt = 20 * solver.explicit_dt();
     for (int stressed = 0; stressed < 2; ++stressed) {
       if (stressed) solver.step(dt);  // now with stress, and u != 0
@@ -110,7 +110,8 @@ TEST(Implicit, MatrixFreeProductMatchesFiniteDifferenceJacobian) {
       long evals = 0;
       double worst = 0;
       for (Eigen::Index j = 0; j < n; ++j) {
-        ASSERT_TRUE(nk::directional_difference(sys, u, F, nk::Vector::Unit(n, j), 1e-5, typ, Js, evals));
+        ASSERT_TRUE(
+            nk::directional_difference(sys, u, F, nk::Vector::Unit(n, j), 1e-5, typ, Js, evals));
         worst = std::max(worst, (Js - J.col(j)).norm() / J.col(j).norm());
       }
       EXPECT_LT(worst, 1e-4) << "worst column, relative";
@@ -121,8 +122,10 @@ TEST(Implicit, MatrixFreeProductMatchesFiniteDifferenceJacobian) {
       EXPECT_LT((Js - J * s).norm(), 1e-4 * (J * s).norm());
       const double asym = (J - J.transpose()).norm() / J.norm();
       if (!stressed) {
-        if (f == Formulation::Velocity) EXPECT_LT(asym, 1e-6);
-        else EXPECT_GT(asym, 1e-2);
+        if (f == Formulation::Velocity)
+          EXPECT_LT(asym, 1e-6);
+        else
+          EXPECT_GT(asym, 1e-2);
       }
     }
   }
@@ -194,8 +197,8 @@ int newton_iterations(Formulation f, bool plastic, double& reduction) {
     m.scene.materials[0].strength.A = 0.05;  // yields at a strain of 5e-5
     m.scene.materials[0].strength.B = 50;
   }
-  ImplicitSolver<UniformGrid<2>> solver(implicit(m.scene, f), UniformGrid<2>(m.lat, m.scene.boundary),
-                                        m.cols);
+  ImplicitSolver<UniformGrid<2>> solver(implicit(m.scene, f),
+                                        UniformGrid<2>(m.lat, m.scene.boundary), m.cols);
   const double dt = 10 * solver.explicit_dt();  // strain increments ~ dt v / h ~ 1e-4
   solver.step(dt);
   nk::Vector u;
@@ -290,6 +293,59 @@ TEST(Implicit, AxisymmetricUniformExpansionGivesTheAnalyticHoopStress) {
   }
 }
 
+// The Lagrangian step restriction (001, section 3.2.7): one cell of material between a rigid
+// pusher and a fixed wall. A step that moves the pusher more than a cell folds that cell
+// whatever Newton does (its nodes would pass each other: det(I + dt L) <= 0 at the
+// particles); the step is cut until the motion is admissible.
+TEST(Implicit, LagrangianRestrictionCutsTheStep) {
+  const double h = 0.1, v = 0.001;
+  Scene scene = scene_with(elastic(1000, 0.3, 10), 2, h, 1e4);
+  BodySpec pusher;
+  pusher.name = "pusher";
+  pusher.rigid = true;
+  pusher.velocity = Vec3(v, 0, 0);
+  scene.bodies.push_back(pusher);
+  scene.boundary.face[1] = BoundaryType::Fixed;
+  const Lattice lat = lattice(2, Vec3::Zero(), h, {7, 5, 1});
+  ColumnStore cols = block<2>(lat, IVec<2>(5, 1), IVec<2>(7, 4), 2, 10,
+                              [](const Vec<2>&) { return Vec<2>::Zero(); });
+  auto p = view<2>(cols);
+  auto* mat = cols.get<std::uint8_t>(col::material);
+  auto* body = cols.get<std::uint8_t>(col::body);
+  for (std::size_t i = 0; i < p.n; ++i)
+    if (p.x[i][0] < 0.6) {
+      mat[i] = kRigidMaterial;
+      body[i] = 1;
+      p.v[i] = Vec<2>(v, 0);
+    }
+  for (Formulation f : {Formulation::Momentum, Formulation::Velocity}) {
+    SCOPED_TRACE(f == Formulation::Velocity ? "velocity" : "momentum");
+    Scene s = implicit(scene, f);
+    s.solver.implicit.dt_initial_multiple = 35000;  // ~150 s: the pusher would move 1.5 cells
+    s.solver.implicit.dt_target_multiple = 35000;
+    ColumnStore c = block<2>(lat, IVec<2>(5, 1), IVec<2>(7, 4), 2, 10,
+                             [](const Vec<2>&) { return Vec<2>::Zero(); });
+    auto q = view<2>(c);
+    for (std::size_t i = 0; i < q.n; ++i) {
+      c.get<std::uint8_t>(col::material)[i] = mat[i];
+      c.get<std::uint8_t>(col::body)[i] = body[i];
+      q.v[i] = p.v[i];
+    }
+    ImplicitSolver<UniformGrid<2>> solver(s, UniformGrid<2>(lat, s.boundary), c);
+    const double dt = solver.stable_dt();
+    ASSERT_GT(v * dt, 1.2 * h);
+    solver.step(dt);
+    EXPECT_GT(solver.work().lagrangian_cuts, 0);
+    EXPECT_LT(v * solver.last_dt(), h) << "the step moved the pusher less than a cell";
+    q = view<2>(c);
+    for (std::size_t i = 0; i < q.n; ++i)
+      if (q.material[i] != kRigidMaterial) {
+        EXPECT_GT(q.rho[i], 10.0);  // compressed, not inverted
+        EXPECT_LT(q.x[i][0], 0.7);  // still inside the wall
+      }
+  }
+}
+
 // The rigid puller's force is what the material exerts on it: the bar, free at its other end,
 // changes its momentum by dP = -sum F_body dt, step by step, up to what the Newton tolerance
 // leaves in the free equations: |sum_i F_i| <= sqrt(n) ||F|| <= sqrt(n) tol per step, times
@@ -313,7 +369,8 @@ TEST(Implicit, RigidAndFaceForcesBalanceTheMomentum) {
       solver.step(std::min(solver.stable_dt(), 2.0 - solver.time()));
       impulse += solver.rigid_force()[1] * solver.last_dt();
       const double n = 2.0 * double(solver.grid().nodes());  // unknowns, at most
-      bound += std::sqrt(n) * s.solver.implicit.newton_tolerance * solver.residual_scale(solver.last_dt());
+      bound += std::sqrt(n) * s.solver.implicit.newton_tolerance *
+               solver.residual_scale(solver.last_dt());
     }
     const Vec3 dp = solver.balance().momentum - p0;
     EXPECT_GT(solver.rigid_force()[1].x(), 0.0);  // the bar holds the puller back (+x)

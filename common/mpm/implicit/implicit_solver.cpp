@@ -18,8 +18,8 @@ namespace mpm {
 template <class GridT>
 void ImplicitSolver<GridT>::step(double dt) {
   if (need_sort_) sort_particles();  // cell order; the grid window follows the material
-  p2g();             // m_i, P_i^k, f_i^k, f_i^ext (001, eqs. 2.2.12, 3.2.3, 2.4.6)
-  free_dofs();       // Dirichlet values; the unknowns are the rest (001, section 2.4.1)
+  p2g();                             // m_i, P_i^k, f_i^k, f_i^ext (001, eqs. 2.2.12, 3.2.3, 2.4.6)
+  free_dofs();  // Dirichlet values; the unknowns are the rest (001, section 2.4.1)
   last_work_ = ImplicitWork{};
   double h = dt;
   for (int cut = 0; !attempt(h); ++cut) {  // F(v^L) = 0 (001, eq. 2.4.13)
@@ -41,8 +41,8 @@ void ImplicitSolver<GridT>::step(double dt) {
   commit(u_);     // v_p, x_p (001, eqs. 2.3.2-2.3.3 or 3.2.5-3.2.6), stress state (eq. 2.3.6)
   // Step control (001, Tables 1-6): ramp the planned step by `ramp` up to the target.
   const double base = last_work_.step_cuts > 0 ? h : std::max(h, next_dt_);
-  next_dt_ = std::min({base * (1.0 + spec_.ramp), spec_.dt_target_multiple * dt_explicit_,
-                       scene_.solver.dt_max});
+  next_dt_ = std::min(
+      {base * (1.0 + spec_.ramp), spec_.dt_target_multiple * dt_explicit_, scene_.solver.dt_max});
   last_dt_ = h;
   time_ += h;
   ++steps_;
@@ -120,15 +120,15 @@ class ImplicitSolver<GridT>::System final : public nk::NonlinearSystem {
     Trial& t = *s_.trial_;
     bool ok;
     if (s_.spec_.formulation == Formulation::Momentum) {
-      s_.to_grid(u, t.P_i);     // P_i^L
-      s_.remap_trial(t.P_i, t); // v_p^L (eq. 3.2.6), v_i^L (eq. 3.2.7)
+      s_.to_grid(u, t.P_i);      // P_i^L
+      s_.remap_trial(t.P_i, t);  // v_p^L (eq. 3.2.6), v_i^L (eq. 3.2.7)
     } else {
-      s_.to_grid(u, t.v_i);     // v_i^L
+      s_.to_grid(u, t.v_i);  // v_i^L
     }
-    ok = s_.stress_trial(t);    // sigma_p^L (001, eqs. 2.2.18-2.2.21)
+    ok = s_.stress_trial(t);  // sigma_p^L (001, eqs. 2.2.18-2.2.21)
     if (ok) {
-      s_.force_trial(t);        // f_i^L (eq. 2.4.7)
-      s_.residual(u, t, F);     // (eq. 2.4.12), dimensionless
+      s_.force_trial(t);     // f_i^L (eq. 2.4.7)
+      s_.residual(u, t, F);  // (eq. 2.4.12), dimensionless
     }
     seconds += omp_get_wtime() - t0;
     return ok;
@@ -174,8 +174,8 @@ ImplicitSolver<GridT>::ImplicitSolver(const Scene& scene, GridT grid, ColumnStor
     std::int64_t key;
     Vec<D> xi;
     if (!p.x[i].allFinite() || grid_.where(p.x[i], key, xi) == Where::OutsideDomain)
-      throw InputError("model", "particle " + std::to_string(p.id[i]) +
-                                    " lies outside the domain of the grid");
+      throw InputError(
+          "model", "particle " + std::to_string(p.id[i]) + " lies outside the domain of the grid");
     if (p.material[i] != kRigidMaterial) m_min = std::min(m_min, p.m[i]);
   }
   node_mass_floor_ = 1e-14 * (std::isfinite(m_min) ? m_min : 1.0);
@@ -196,8 +196,8 @@ ImplicitSolver<GridT>::ImplicitSolver(const Scene& scene, GridT grid, ColumnStor
   balance_.leapfrog_total = total0_ = balance_.total();
   energy_scale_ = std::max(std::abs(total0_), balance_.kinetic);
   const double h = grid_.min_cell_size();
-  dt_explicit_ = std::min(scene_.solver.dt_max, speed > 0 ? scene_.solver.cfl * h / speed
-                                                          : scene_.solver.dt_max);
+  dt_explicit_ = std::min(scene_.solver.dt_max,
+                          speed > 0 ? scene_.solver.cfl * h / speed : scene_.solver.dt_max);
   if (!std::isfinite(dt_explicit_) || !(dt_explicit_ > 0))
     throw InputError(where(scene_.source, 0, "solver.dt_max"),
                      "the implicit solver needs a reference time step: the scene has no "
@@ -320,7 +320,7 @@ void ImplicitSolver<GridT>::p2g() {
           const std::int64_t n = nd[c];
           grid_.m[n] += m_p * N[c];
           P_k_[n] += N[c] * m_p * p.v[i];
-          Vec<D> f = -Vsigma * G[c];  // (001, eqs. 2.2.9-2.2.10)
+          Vec<D> f = -Vsigma * G[c];          // (001, eqs. 2.2.9-2.2.10)
           if (axi) f[0] -= Vs_hoop_r * N[c];  // hoop stress (Sulsky & Schreyer 1996)
           f_k_[n] += f;
           f_ext_[n] += N[c] * fb;
@@ -404,6 +404,10 @@ bool ImplicitSolver<GridT>::attempt(double dt) {
   last_work_.evaluations += rep.work.evaluations;
   last_work_.line_search_cuts += rep.work.line_search_cuts;
   last_residuals_ = rep.residuals;
+  if (rep.outcome == nk::Outcome::InadmissibleStart) {  // the guess folds a particle's
+    ++last_work_.lagrangian_cuts;                       // neighbourhood: det(I + dt L) <= 0
+    return false;
+  }
   if (!rep.converged()) return false;
   // The grid motion the strain came from: v_i^L (velocity formulation), or the remapped
   // v_i^L of eq. 3.2.7 (momentum formulation; P_i / m_i itself is unbounded where m_i is
@@ -504,7 +508,8 @@ void ImplicitSolver<GridT>::remap_trial(const std::vector<Vec<D>>& P_L, Trial& t
         const double* N = &N_p_[i * NMAX];
         Vec<D> v = p.v[i];
         for (int c = 0; c < nn; ++c)
-          if (grid_.m[nd[c]] > floor) v += N[c] * increment(nd[c], P_L[nd[c]] - P_k_[nd[c]]) / grid_.m[nd[c]];
+          if (grid_.m[nd[c]] > floor)
+            v += N[c] * increment(nd[c], P_L[nd[c]] - P_k_[nd[c]]) / grid_.m[nd[c]];
         t.v_p[i] = v;
         const Vec<D> mv = p.m[i] * v;
         for (int c = 0; c < nn; ++c) q[nd[c]] += N[c] * mv;
@@ -813,9 +818,9 @@ void ImplicitSolver<GridT>::commit(const nk::Vector& u) {
         char where_[160];
         std::snprintf(where_, sizeof where_, "left the domain at (%.4g, %.4g, %.4g) m", p.x[i][0],
                       p.x[i][1], D == 3 ? p.x[i][D - 1] : 0.0);
-        throw InstabilityError(steps_ + 1, time_ + dt, p.id[i],
-                               std::string(where_) +
-                                   " (enlarge grid.domain, or set solver.on_exit = \"remove\")");
+        throw InstabilityError(
+            steps_ + 1, time_ + dt, p.id[i],
+            std::string(where_) + " (enlarge grid.domain, or set solver.on_exit = \"remove\")");
       }
       exits_.push_back(i);
     }

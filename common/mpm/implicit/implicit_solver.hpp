@@ -105,18 +105,18 @@ class ImplicitSolver {
 
   // Kernels, in the order a step uses them.
   void sort_particles();
-  void p2g();                         // m_i, P_i^k, f_i^k, f_i^ext, stiffness diagonal, rigid marks
-  void free_dofs();                   // Dirichlet values and the unknowns
-  bool attempt(double dt);            // Newton-Krylov for one dt; true when converged and unfolded
+  void p2g();               // m_i, P_i^k, f_i^k, f_i^ext, stiffness diagonal, rigid marks
+  void free_dofs();         // Dirichlet values and the unknowns
+  bool attempt(double dt);  // Newton-Krylov for one dt; true when converged and unfolded
   nk::NonlinearSystem& system_for_current(double dt, nk::Vector& u0);  // scale, guess, diagonal
-  void to_grid(const nk::Vector& u, std::vector<Vec<D>>& w) const;  // unknowns to grid
-  void remap_trial(const std::vector<Vec<D>>& P_L, Trial& t);       // momentum: v_p^L, v_i^L
-  bool stress_trial(Trial& t);        // velocity gradient, constitutive update on a copy
-  void force_trial(Trial& t);         // f_i^L from the trial stress
+  void to_grid(const nk::Vector& u, std::vector<Vec<D>>& w) const;     // unknowns to grid
+  void remap_trial(const std::vector<Vec<D>>& P_L, Trial& t);          // momentum: v_p^L, v_i^L
+  bool stress_trial(Trial& t);  // velocity gradient, constitutive update on a copy
+  void force_trial(Trial& t);   // f_i^L from the trial stress
   void residual(const nk::Vector& u, const Trial& t, nk::Vector& F) const;
   bool folds(const std::vector<Vec<D>>& v) const;  // Lagrangian step restriction
-  void reactions(const nk::Vector& u);  // forces on rigid bodies and faces
-  void commit(const nk::Vector& u);     // particles: v, x, stress state; energies
+  void reactions(const nk::Vector& u);             // forces on rigid bodies and faces
+  void commit(const nk::Vector& u);                // particles: v, x, stress state; energies
 
   // Helpers.
   template <class F>
@@ -158,21 +158,21 @@ class ImplicitSolver {
   std::array<double, 6> face_force_{};
 
   // The step being solved (grid-sized unless noted).
-  std::vector<Vec<D>> P_k_;      ///< P_i^k = sum_p m_p v_p N_ip (001, eq. 3.2.3)
-  std::vector<Vec<D>> v_k_;      ///< v_i^k = P_i^k / m_i (unconstrained)
-  std::vector<Vec<D>> f_k_;      ///< internal force from sigma^k (001, eq. 2.4.6)
-  std::vector<Vec<D>> f_ext_;    ///< body forces and loads
-  std::vector<Vec<D>> k_diag_;   ///< diagonal of the elastic stiffness, N/m
-  std::vector<std::uint8_t> held_;  ///< bit a: component a is prescribed (Dirichlet)
+  std::vector<Vec<D>> P_k_;              ///< P_i^k = sum_p m_p v_p N_ip (001, eq. 3.2.3)
+  std::vector<Vec<D>> v_k_;              ///< v_i^k = P_i^k / m_i (unconstrained)
+  std::vector<Vec<D>> f_k_;              ///< internal force from sigma^k (001, eq. 2.4.6)
+  std::vector<Vec<D>> f_ext_;            ///< body forces and loads
+  std::vector<Vec<D>> k_diag_;           ///< diagonal of the elastic stiffness, N/m
+  std::vector<std::uint8_t> held_;       ///< bit a: component a is prescribed (Dirichlet)
   std::vector<std::uint8_t> face_held_;  ///< bit a: ... by a wall (not a rigid body)
-  std::vector<Vec<D>> v_bc_;     ///< prescribed velocities
-  std::vector<std::int64_t> dof_node_;  ///< unknown -> node
-  std::vector<int> dof_axis_;           ///< unknown -> component
-  std::vector<double> N_p_;      ///< shape functions at x_p^k, NMAX per particle
-  std::vector<Vec<D>> G_p_;      ///< their gradients, 1/m
+  std::vector<Vec<D>> v_bc_;             ///< prescribed velocities
+  std::vector<std::int64_t> dof_node_;   ///< unknown -> node
+  std::vector<int> dof_axis_;            ///< unknown -> component
+  std::vector<double> N_p_;              ///< shape functions at x_p^k, NMAX per particle
+  std::vector<Vec<D>> G_p_;              ///< their gradients, 1/m
   double u_typ_ = 0;
   nk::Vector inv_diag_;
-  nk::Vector u_;                 ///< the converged unknowns
+  nk::Vector u_;  ///< the converged unknowns
   std::unique_ptr<Trial> trial_, accepted_;
   std::unique_ptr<System> system_;
   std::vector<std::unique_ptr<Scratch>> scratch_;  ///< per thread

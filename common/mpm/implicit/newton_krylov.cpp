@@ -10,11 +10,16 @@ namespace mpm::nk {
 
 std::string to_string(Outcome o) {
   switch (o) {
-    case Outcome::Converged: return "converged";
-    case Outcome::InadmissibleStart: return "the initial guess is inadmissible (folded grid or inverted volume)";
-    case Outcome::NoDescent: return "the line search found no decrease of the residual";
-    case Outcome::TooManyIterations: return "too many Newton iterations";
-    case Outcome::ZeroStep: return "the Krylov solve gave no step";
+    case Outcome::Converged:
+      return "converged";
+    case Outcome::InadmissibleStart:
+      return "the initial guess is inadmissible (folded grid or inverted volume)";
+    case Outcome::NoDescent:
+      return "the line search found no decrease of the residual";
+    case Outcome::TooManyIterations:
+      return "too many Newton iterations";
+    case Outcome::ZeroStep:
+      return "the Krylov solve gave no step";
   }
   return "?";
 }
@@ -33,7 +38,7 @@ LinearReport cg(const Operator& A, const Vector& b, Vector& x, double rtol, int 
     rep.relative_residual = 0;
     return rep;
   }
-  Vector r = b;                                         // r_0 = b - A 0
+  Vector r = b;  // r_0 = b - A 0
   Vector z = inv_diag ? Vector(inv_diag->cwiseProduct(r)) : r;
   Vector p = z, w(n);
   double rho = r.dot(z);
@@ -44,7 +49,7 @@ LinearReport cg(const Operator& A, const Vector& b, Vector& x, double rtol, int 
       return rep;
     }
     ++rep.iterations;
-    if (!A(p, w)) {                                     // (a) w_k = D_h F(v_n, p_k)
+    if (!A(p, w)) {  // (a) w_k = D_h F(v_n, p_k)
       rep.failed = true;
       return rep;
     }
@@ -53,14 +58,16 @@ LinearReport cg(const Operator& A, const Vector& b, Vector& x, double rtol, int 
       rep.failed = k == 0;
       return rep;
     }
-    const double alpha = rho / pw;                      // (b)
-    x.noalias() += alpha * p;                           // (c)
-    r.noalias() -= alpha * w;                           // (d)
-    if (inv_diag) z = inv_diag->cwiseProduct(r);
-    else z = r;
-    const double rho_new = r.dot(z);                    // (e)
-    const double beta = rho_new / rho;                  // (f)
-    p = z + beta * p;                                   // (g)
+    const double alpha = rho / pw;  // (b)
+    x.noalias() += alpha * p;       // (c)
+    r.noalias() -= alpha * w;       // (d)
+    if (inv_diag)
+      z = inv_diag->cwiseProduct(r);
+    else
+      z = r;
+    const double rho_new = r.dot(z);    // (e)
+    const double beta = rho_new / rho;  // (f)
+    p = z + beta * p;                   // (g)
     rho = rho_new;
   }
   rep.relative_residual = r.norm() / b_norm;
@@ -83,7 +90,7 @@ LinearReport gmres(const Operator& A, const Vector& b, Vector& x, double rtol, i
     return rep;
   }
   const int m = std::max(1, basis);
-  Eigen::MatrixXd V(n, m + 1);       // orthonormal basis p_1 .. p_{k+1}
+  Eigen::MatrixXd V(n, m + 1);  // orthonormal basis p_1 .. p_{k+1}
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m + 1, m);
   Eigen::VectorXd cs(m), sn(m), g(m + 1);
   Vector r = b, w(n), z(n);
@@ -113,31 +120,31 @@ LinearReport gmres(const Operator& A, const Vector& b, Vector& x, double rtol, i
     for (int j = 0; j < m; ++j) {
       ++rep.iterations;
       z = precondition(V.col(j));
-      if (!A(z, w)) {                                  // (a) p_{k+1} = D_h F(v_n, p_k)
+      if (!A(z, w)) {  // (a) p_{k+1} = D_h F(v_n, p_k)
         if (j == 0) {
           rep.failed = true;
           return rep;
         }
         break;  // use the basis built so far
       }
-      for (int i = 0; i <= j; ++i) {                   // (b) modified Gram-Schmidt
+      for (int i = 0; i <= j; ++i) {  // (b) modified Gram-Schmidt
         H(i, j) = w.dot(V.col(i));
         w.noalias() -= H(i, j) * V.col(i);
       }
-      H(j + 1, j) = w.norm();                          // (c)
+      H(j + 1, j) = w.norm();                               // (c)
       if (H(j + 1, j) > 0) V.col(j + 1) = w / H(j + 1, j);  // (d)
-      for (int i = 0; i < j; ++i) {                    // (e) previous rotations
+      for (int i = 0; i < j; ++i) {                         // (e) previous rotations
         const double t = cs[i] * H(i, j) + sn[i] * H(i + 1, j);
         H(i + 1, j) = -sn[i] * H(i, j) + cs[i] * H(i + 1, j);
         H(i, j) = t;
       }
-      const double a = H(j, j), c = H(j + 1, j);       // (f) new rotation
+      const double a = H(j, j), c = H(j + 1, j);  // (f) new rotation
       const double d = std::hypot(a, c);
       cs[j] = d > 0 ? a / d : 1.0;
       sn[j] = d > 0 ? c / d : 0.0;
       H(j, j) = d;
       H(j + 1, j) = 0;
-      g[j + 1] = -sn[j] * g[j];                        // (g) rotate beta e_1
+      g[j + 1] = -sn[j] * g[j];  // (g) rotate beta e_1
       g[j] = cs[j] * g[j];
       k = j + 1;
       rep.relative_residual = std::abs(g[j + 1]) / b_norm;
@@ -145,8 +152,7 @@ LinearReport gmres(const Operator& A, const Vector& b, Vector& x, double rtol, i
     }
     if (k == 0) break;
     // Step 3: solve the k x k triangular system R y = g; Step 4: x += P^-1 V y.
-    const Eigen::VectorXd y =
-        H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
+    const Eigen::VectorXd y = H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
     x += precondition(V.leftCols(k) * y);
     if (rep.relative_residual <= rtol) {
       rep.converged = true;
@@ -164,7 +170,7 @@ bool directional_difference(NonlinearSystem& system, const Vector& u, const Vect
                             long& evaluations) {
   const double s_norm = s.norm();
   Js.setZero(F_u.size());
-  if (s_norm == 0) return true;  // (001, eq. 2.4.18), s = 0
+  if (s_norm == 0) return true;                  // (001, eq. 2.4.18), s = 0
   double sigma = h * std::max(u.norm(), u_typ);  // h ||v||, or h when v = 0
   if (!(sigma > 0)) sigma = h;
   Vector F_p(F_u.size());
@@ -222,10 +228,9 @@ Report solve(NonlinearSystem& system, Vector& u, const Settings& S, const Vector
     // Steps 3-4: J(v_n) s = -F(v_n), matrix-free (001, eq. 2.4.19).
     ++rep.work.newton;
     const Vector b = -F;
-    const LinearReport lin =
-        S.krylov == KrylovMethod::CG
-            ? cg(J, b, s, eta, S.max_krylov, inv_diag)
-            : gmres(J, b, s, eta, S.gmres_basis, S.gmres_restarts, inv_diag);
+    const LinearReport lin = S.krylov == KrylovMethod::CG
+                                 ? cg(J, b, s, eta, S.max_krylov, inv_diag)
+                                 : gmres(J, b, s, eta, S.gmres_basis, S.gmres_restarts, inv_diag);
     rep.work.krylov += lin.iterations;
     if (!(s.squaredNorm() > 0) || !s.allFinite()) {
       rep.outcome = Outcome::ZeroStep;

@@ -34,10 +34,10 @@ using Operator = std::function<bool(const Vector& x, Vector& y)>;
 
 /// How a Krylov solve ended.
 struct LinearReport {
-  int iterations = 0;                ///< operator applications
-  double relative_residual = 1.0;    ///< ||b - A x|| / ||b|| (GMRES: its estimate)
+  int iterations = 0;              ///< operator applications
+  double relative_residual = 1.0;  ///< ||b - A x|| / ||b|| (GMRES: its estimate)
   bool converged = false;
-  bool failed = false;               ///< the operator could not be applied, or CG broke down
+  bool failed = false;  ///< the operator could not be applied, or CG broke down
 };
 
 /// Preconditioned conjugate gradients for A x = b from x = 0 (001, Algorithm 3). `inv_diag`
@@ -61,14 +61,14 @@ struct Settings {
   KrylovMethod krylov = KrylovMethod::GMRES;
   int gmres_basis = 20;
   int gmres_restarts = 0;
-  int max_krylov = 200;            ///< CG iterations per Newton step
+  int max_krylov = 200;  ///< CG iterations per Newton step
   int max_newton = 25;
-  int max_line_search = 8;         ///< halvings of the Newton step
+  int max_line_search = 8;  ///< halvings of the Newton step
   Forcing forcing = Forcing::Fixed;
-  double eta_max = 0.5;            ///< Eisenstat-Walker: largest forcing term (Kelley: 0.9;
-                                   ///< 0.5 measured better on the V7 upsetting, equal elsewhere)
-  double ew_gamma = 0.9;           ///< Eisenstat-Walker: gamma of choice 2
-  double armijo = 1e-4;            ///< sufficient decrease: ||F_new|| <= (1 - armijo lambda) ||F||
+  double eta_max = 0.5;   ///< Eisenstat-Walker: largest forcing term (Kelley: 0.9;
+                          ///< 0.5 measured better on the V7 upsetting, equal elsewhere)
+  double ew_gamma = 0.9;  ///< Eisenstat-Walker: gamma of choice 2
+  double armijo = 1e-4;   ///< sufficient decrease: ||F_new|| <= (1 - armijo lambda) ||F||
 };
 
 /// Work done, summed over calls.
@@ -88,10 +88,10 @@ struct Counters {
 
 enum class Outcome {
   Converged,
-  InadmissibleStart,   ///< F could not be evaluated at the initial guess
-  NoDescent,           ///< the line search found no acceptable point
-  TooManyIterations,   ///< max_newton reached
-  ZeroStep,            ///< the Krylov solve gave no step
+  InadmissibleStart,  ///< F could not be evaluated at the initial guess
+  NoDescent,          ///< the line search found no acceptable point
+  TooManyIterations,  ///< max_newton reached
+  ZeroStep,           ///< the Krylov solve gave no step
 };
 std::string to_string(Outcome o);
 
