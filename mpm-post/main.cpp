@@ -1,6 +1,7 @@
 // mpm-post: what users report from a result stream.
 //   mpm-post summary run.mpm            mpm-post history run.mpm -o history.csv
 //   mpm-post vtk run.mpm -o out/        mpm-post taylor run.mpm --json
+//   mpm-post particles run.mpm --columns x,sigma -o last.csv
 //   mpm-post render run.mpm -o bar.png --field eps_p
 #include <CLI/CLI.hpp>
 #include <cmath>
@@ -359,6 +360,94 @@ int cmd_debris(const std::string& path, const DebrisArgs& a) {
   return conclude(path, s, frames);
 }
 
+// particles -------------------------------------------------------------------------------
+/// One value of element i, component k of a column, as a double.
+double column_value(const Column& c, std::size_t i, int k) {
+  const std::size_t at = i * std::size_t(c.info().components) + std::size_t(k);
+  const std::byte* d = c.data();
+  switch (c.info().type) {
+    case ScalarType::F64:
+      return reinterpret_cast<const double*>(d)[at];
+    case ScalarType::F32:
+      return reinterpret_cast<const float*>(d)[at];
+    case ScalarType::U8:
+      return double(reinterpret_cast<const std::uint8_t*>(d)[at]);
+    case ScalarType::U32:
+      return double(reinterpret_cast<const std::uint32_t*>(d)[at]);
+    case ScalarType::I32:
+      return double(reinterpret_cast<const std::int32_t*>(d)[at]);
+    case ScalarType::U64:
+      return double(reinterpret_cast<const std::uint64_t*>(d)[at]);
+  }
+  return NAN;
+}
+
+/// The particles of one frame as CSV: a column per component (x_0, x_1, sigma_0 ... sigma_5).
+int cmd_particles(const std::string& path, const std::string& out, const std::string& frame,
+                  const std::vector<std::string>& cols) {
+  long want = -1;
+  if (frame != "last") {
+    char* end = nullptr;
+    want = std::strtol(frame.c_str(), &end, 10);
+    if (!end || *end || want < 0)
+      throw InputError("--frame", "expected a frame index or 'last', got '" + frame + "'");
+  }
+  std::optional<Frame> chosen;
+  long index = 0;
+  StreamVisitor v;
+  v.frame = [&](Frame&& f) {
+    if (want < 0 || index == want) chosen = std::move(f);
+    ++index;
+  };
+  const StreamSummary s = read_stream(path, v);
+  if (!chosen) {
+    std::fprintf(stderr, "mpm-post: error: %s has no frame %s (it holds %ld)\n",
+                 input_name(path).c_str(), frame.c_str(), index);
+    return kExitBadInput;
+  }
+  std::vector<const Column*> picked;
+  if (cols.empty()) {
+    for (const auto& c : chosen->columns.columns()) picked.push_back(&c);
+  } else {
+    for (const auto& name : cols) {
+      const Column* c = chosen->columns.find(name);
+      if (!c) {
+        std::string known;
+        for (const auto& k : chosen->columns.columns())
+          known += (known.empty() ? "" : ", ") + k.info().name;
+        throw InputError("--columns",
+                         "unknown particle column '" + name + "' (known: " + known + ")");
+      }
+      picked.push_back(c);
+    }
+  }
+  std::FILE* f = out == "-" ? stdout : std::fopen(out.c_str(), "w");
+  if (!f) throw IoError("cannot write '" + out + "': " + std::strerror(errno));
+  std::fprintf(f, "# t = %.10g s, step %lld\n", chosen->time, (long long)chosen->step);
+  bool first = true;
+  for (const Column* c : picked)
+    for (int k = 0; k < c->info().components; ++k) {
+      std::fprintf(f, "%s%s", first ? "" : ",", c->info().name.c_str());
+      if (c->info().components > 1) std::fprintf(f, "_%d", k);
+      first = false;
+    }
+  std::fprintf(f, "\n");
+  for (std::size_t i = 0; i < chosen->columns.size(); ++i) {
+    first = true;
+    for (const Column* c : picked)
+      for (int k = 0; k < c->info().components; ++k) {
+        std::fprintf(f, "%s%.10g", first ? "" : ",", column_value(*c, i, k));
+        first = false;
+      }
+    std::fprintf(f, "\n");
+  }
+  if (f != stdout)
+    std::fclose(f);
+  else
+    std::fflush(stdout);
+  return conclude(path, s, std::size_t(index));
+}
+
 // render ----------------------------------------------------------------------------------
 struct RenderArgs {
   std::string output = "frame.png", frame = "last", time, size = "1200x900", range;
@@ -431,6 +520,17 @@ int main(int argc, char** argv) {
   history->add_option("-o,--output", hist_out, "CSV file, - for stdout")->capture_default_str();
   history->add_option("--columns", hist_cols, "columns to print (default all)")->delimiter(',');
 
+  auto* particles = app.add_subcommand(
+      "particles", "the particles of one frame as CSV (one column per component)");
+  std::string part_out = "-", part_frame = "last";
+  std::vector<std::string> part_cols;
+  particles->add_option("input", input, "stream, - for stdin")->capture_default_str();
+  particles->add_option("-o,--output", part_out, "CSV file, - for stdout")->capture_default_str();
+  particles->add_option("--frame", part_frame, "frame index (0 = first) or 'last'")
+      ->capture_default_str();
+  particles->add_option("--columns", part_cols, "particle columns (default all), e.g. x,sigma")
+      ->delimiter(',');
+
   auto* vtk = app.add_subcommand("vtk", "ParaView files: a .vtu per frame and a .pvd series");
   std::string vtk_dir = "vtk", vtk_name = "frame";
   int vtk_every = 1;
@@ -494,6 +594,7 @@ int main(int argc, char** argv) {
     mpm::ignore_sigpipe();
     if (*summary) return cmd_summary(input, summary_json);
     if (*history) return cmd_history(input, hist_out, hist_cols);
+    if (*particles) return cmd_particles(input, part_out, part_frame, part_cols);
     if (*vtk) return cmd_vtk(input, vtk_dir, vtk_name, vtk_every);
     if (*taylor) return cmd_taylor(input, ta);
     if (*debris) return cmd_debris(input, da);

@@ -89,7 +89,9 @@ int prepare_model(const PrepOptions& opt) {
   if (!opt.quiet) {
     std::fprintf(stderr, "mpm-prep: %s%s%s (%dD%s)\n", scene.source.c_str(),
                  scene.title.empty() ? "" : ": ", scene.title.c_str(), d,
-                 d == 2 ? ", plane strain, masses per metre" : "");
+                 d == 2 ? (scene.axisymmetric ? ", axisymmetric, masses per radian"
+                                              : ", plane strain, masses per metre")
+                        : "");
     std::fprintf(stderr, "  grid: cell %s mm, domain [%s, %s] x [%s, %s]", mm(lattice.h).c_str(),
                  mm(lattice.origin[0]).c_str(), mm(lattice.max()[0]).c_str(),
                  mm(lattice.origin[1]).c_str(), mm(lattice.max()[1]).c_str());
@@ -105,8 +107,9 @@ int prepare_model(const PrepOptions& opt) {
       const BodyReport& r = report[b];
       total += r.particles;
       std::fprintf(stderr, "  %-14s %-12s %12zu %7s mm %14.6g %14.6g %7.2f%%\n", r.name.c_str(),
-                   scene.materials[scene.bodies[b].material].name.c_str(), r.particles,
-                   mm(r.spacing).c_str(), r.mass, r.exact_mass,
+                   scene.bodies[b].rigid ? "(rigid)"
+                                         : scene.materials[scene.bodies[b].material].name.c_str(),
+                   r.particles, mm(r.spacing).c_str(), r.mass, r.exact_mass,
                    r.exact_mass > 0 ? 100.0 * (r.mass - r.exact_mass) / r.exact_mass : 0.0);
       if (r.skipped_overlap > 0)
         std::fprintf(stderr, "  (body '%s': %zu points inside earlier bodies were not created)\n",

@@ -6,15 +6,15 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
 #include <sstream>
 
 #include "mpm/error.hpp"
 #include "mpm/explicit_solver.hpp"
+#include "mpm/implicit/implicit_solver.hpp"
 #include "mpm/lattice.hpp"
 #include "mpm/stream.hpp"
 #include "mpm/version.hpp"
-
-#include <fstream>
 
 namespace mpm {
 
@@ -65,10 +65,18 @@ Model read_model(const std::string& path) {
   return model;
 }
 
+/// True for a solver with the implicit one's work counters.
+template <class Solver>
+concept HasImplicitWork = requires(const Solver& s) {
+  s.work();
+  s.explicit_dt();
+};
+
 /// History rows, written as HIST records at each frame and every few thousand rows.
 class History {
  public:
-  History(int dim, const Scene& scene) : dim_(dim), factor_(scene.measure_factor()) {
+  History(int dim, const Scene& scene, bool implicit)
+      : dim_(dim), factor_(scene.measure_factor()), implicit_(implicit) {
     const BoundarySpec& bc = scene.boundary;
     add("step", "-");
     add("time", "s");
@@ -93,6 +101,18 @@ class History {
         for (int a = 0; a < dim; ++a)
           add("force_" + scene.bodies[b].name + "_" + "xyz"[a], "N");
       }
+    if (implicit_) {
+      // Work of the implicit solver since the previous row, then totals since t = 0.
+      add("dt_multiple", "-");
+      add("newton", "-");
+      add("krylov", "-");
+      add("residual_evals", "-");
+      add("line_search_cuts", "-");
+      add("step_cuts", "-");
+      add("newton_total", "-");
+      add("krylov_total", "-");
+      add("residual_evals_total", "-");
+    }
   }
   template <class Solver>
   void record(const Solver& s, double dt) {
@@ -106,6 +126,16 @@ class History {
     for (int f : faces_) row.push_back(factor_ * s.face_force()[f]);
     for (int b : rigid_)
       for (int a = 0; a < dim_; ++a) row.push_back(factor_ * s.rigid_force()[b][a]);
+    if constexpr (HasImplicitWork<Solver>) {
+      const ImplicitWork& w = s.work();
+      row.insert(row.end(),
+                 {dt / s.explicit_dt(), double(w.newton - last_.newton),
+                  double(w.krylov - last_.krylov), double(w.evaluations - last_.evaluations),
+                  double(w.line_search_cuts - last_.line_search_cuts),
+                  double(w.step_cuts - last_.step_cuts), double(w.newton), double(w.krylov),
+                  double(w.evaluations)});
+      last_ = w;
+    }
     block_.values.insert(block_.values.end(), row.begin(), row.end());
   }
   void flush(StreamWriter& w) {
@@ -122,6 +152,8 @@ class History {
   }
   int dim_;
   double factor_;
+  bool implicit_;
+  ImplicitWork last_;  ///< totals at the previous row
   std::vector<int> faces_, rigid_;
   HistoryBlock block_;
 };
@@ -135,15 +167,11 @@ std::string run_info(const Scene& scene, const Lattice& lat, int threads) {
   return o.str();
 }
 
-template <int D>
-int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame& model) {
+template <class Solver>
+int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Solver& solver) {
+  constexpr int D = Solver::D;
+  constexpr bool implicit = HasImplicitWork<Solver>;
   const int threads = omp_get_max_threads();
-  const ScatterStrategy strategy = parse_strategy(opt.strategy, "--strategy");
-  if (opt.deterministic && strategy != ScatterStrategy::Colored)
-    throw InputError("--deterministic",
-                     "only the colored strategy gives results independent of the thread count "
-                     "(it is the default); drop --strategy " + opt.strategy);
-  UniformSolver<D> solver(scene, UniformGrid<D>(lattice, scene.boundary), model.columns, strategy);
   StreamWriter out(opt.output);
   out.write_text(RecordType::Scene, scene.toml);
   out.write_text(RecordType::Info, run_info(scene, lattice, threads));
@@ -153,7 +181,7 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
   KernelTimers& timers = solver.timers();
   const int t_output = timers.id("output");
 
-  History history(D, scene);
+  History history(D, scene, implicit);
   auto emit_frame = [&](std::uint32_t flags) {
     ScopedTimer timer(timers, t_output);
     history.flush(out);
@@ -183,6 +211,7 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
   int status = kExitOk;
   std::string message;
   const long max_steps = scene.solver.max_steps;
+  const double loop_start = omp_get_wtime();
   try {
     while (solver.time() < end * (1 - 1e-12)) {
       if (g_signal) {
@@ -204,6 +233,7 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
         throw InstabilityError(solver.steps(), solver.time(), -1,
                                "the stable time step is " + std::to_string(dt) + " s");
       solver.step(dt);
+      if constexpr (implicit) dt = solver.last_dt();  // cut when Newton failed
       if (solver.time() >= next_history * (1 - 1e-12) || o.history_interval <= 0) {
         history.record(solver, dt);
         next_history += o.history_interval;
@@ -230,6 +260,7 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
     status = kExitUnstable;
     message = e.what();
   }
+  const double loop_wall = omp_get_wtime() - loop_start;  // the time loop, output included
   history.flush(out);
   out.write_end(status, message);
   out.close();
@@ -248,20 +279,56 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
     const double ps = solver.particle_steps();
     const double wall = timers.total();
     std::fprintf(stderr, "\n%s", timers.table(ps).c_str());
+    std::string strategy = "colored";
+    std::size_t work_bytes = 0;
+    if constexpr (!implicit) {
+      strategy = to_string(solver.strategy());
+      work_bytes = solver.work_bytes();
+    }
     std::fprintf(stderr,
                  "\nstrategy %s, threads %d, particles %zu, steps %ld, sorts %ld, particle-steps "
                  "%.4g, %.3f million particle-steps/s\n",
-                 to_string(solver.strategy()).c_str(), threads, solver.particles().size(),
-                 solver.steps(), solver.binning().sorts(), ps, wall > 0 ? ps / wall / 1e6 : 0.0);
+                 strategy.c_str(), threads, solver.particles().size(), solver.steps(),
+                 solver.binning().sorts(), ps, wall > 0 ? ps / wall / 1e6 : 0.0);
     const double peak = peak_memory();
     std::fprintf(stderr,
                  "peak memory %.1f MB, %.0f bytes per particle (all of the process: particles, "
                  "grid window, sort scratch, the model as read); particle columns %zu bytes, grid "
-                 "window %zu nodes, solver work arrays %.1f MB\n",
+                 "window %zu nodes%s\n",
                  peak / 1e6, peak / double(std::max<std::size_t>(1, solver.particles().size())),
-                 solver.particles().element_bytes(), solver.grid().nodes(), solver.work_bytes() / 1e6);
+                 solver.particles().element_bytes(), solver.grid().nodes(),
+                 implicit ? "" : (", solver work arrays " + std::to_string(work_bytes / 1000000) +
+                                  " MB").c_str());
+    if constexpr (implicit) {
+      const ImplicitWork& w = solver.work();
+      std::fprintf(stderr,
+                   "implicit: explicit dt %.6g s, steps %ld, newton %ld, krylov %ld, residual "
+                   "evaluations %ld, line-search cuts %ld, step cuts %ld (lagrangian %ld), wall "
+                   "%.4f s (time loop)\n",
+                   solver.explicit_dt(), w.steps, w.newton, w.krylov, w.evaluations,
+                   w.line_search_cuts, w.step_cuts, w.lagrangian_cuts, loop_wall);
+    } else {
+      std::fprintf(stderr, "explicit: steps %ld, wall %.4f s (time loop)\n", solver.steps(),
+                   loop_wall);
+    }
   }
   return status;
+}
+
+template <int D>
+int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame& model) {
+  if (scene.solver.type == SolverType::Implicit) {
+    ImplicitSolver<UniformGrid<D>> solver(scene, UniformGrid<D>(lattice, scene.boundary),
+                                          model.columns);
+    return run_solver(opt, scene, lattice, solver);
+  }
+  const ScatterStrategy strategy = parse_strategy(opt.strategy, "--strategy");
+  if (opt.deterministic && strategy != ScatterStrategy::Colored)
+    throw InputError("--deterministic",
+                     "only the colored strategy gives results independent of the thread count "
+                     "(it is the default); drop --strategy " + opt.strategy);
+  UniformSolver<D> solver(scene, UniformGrid<D>(lattice, scene.boundary), model.columns, strategy);
+  return run_solver(opt, scene, lattice, solver);
 }
 
 }  // namespace

@@ -848,8 +848,68 @@ void read_boundary(Reader& r, Scene& s) {
   r.finish();
 }
 
+void read_implicit(Reader& r, ImplicitSpec& m) {
+  m.theta = r.number("theta", Bound::NonNegative).value_or(1.0);
+  r.check("theta", m.theta <= 1.0, "must be between 0 (explicit) and 1 (fully implicit)");
+  m.formulation = r.choice<Formulation>("formulation", {{"velocity", Formulation::Velocity},
+                                                        {"momentum", Formulation::Momentum}})
+                      .value_or(Formulation::Momentum);
+  const KrylovMethod natural =
+      m.formulation == Formulation::Velocity ? KrylovMethod::CG : KrylovMethod::GMRES;
+  m.krylov =
+      r.choice<KrylovMethod>("krylov", {{"cg", KrylovMethod::CG}, {"gmres", KrylovMethod::GMRES}})
+          .value_or(natural);
+  if (m.krylov == KrylovMethod::CG && m.formulation == Formulation::Momentum)
+    r.fail("krylov",
+           "CG needs a symmetric Jacobian, and the momentum formulation's is not (001, section "
+           "3.2): use krylov = \"gmres\", or formulation = \"velocity\"");
+  m.newton_tolerance = r.number("newton_tolerance", Bound::Positive).value_or(1e-5);
+  m.linear_tolerance = r.number("linear_tolerance", Bound::Positive).value_or(1e-3);
+  r.check("linear_tolerance", m.linear_tolerance < 1.0, "must be below 1");
+  m.derivative_step = r.number("derivative_step", Bound::Positive).value_or(1e-5);
+  r.check("derivative_step", m.derivative_step < 1.0, "must be below 1 (the seed uses 1e-5)");
+  m.gmres_basis = static_cast<int>(r.integer("gmres_basis", 1, 1000).value_or(20));
+  m.gmres_restarts = static_cast<int>(r.integer("gmres_restarts", 0, 1000).value_or(0));
+  m.max_krylov = static_cast<int>(r.integer("max_krylov", 1, 100000).value_or(200));
+  m.max_newton = static_cast<int>(r.integer("max_newton", 1, 10000).value_or(25));
+  m.max_line_search = static_cast<int>(r.integer("max_line_search", 0, 60).value_or(8));
+  m.dt_initial_multiple = r.number("dt_initial_multiple", Bound::Positive).value_or(1.0);
+  m.dt_target_multiple = r.number("dt_target_multiple", Bound::Positive).value_or(100.0);
+  r.check("dt_target_multiple", m.dt_target_multiple >= m.dt_initial_multiple,
+          "must be >= dt_initial_multiple (" + format_number(m.dt_initial_multiple) + ")");
+  m.ramp = r.number("ramp", Bound::NonNegative).value_or(0.2);
+  m.cut = r.number("cut", Bound::Positive).value_or(0.5);
+  r.check("cut", m.cut < 1.0, "must be below 1 (the factor on a step that failed)");
+  m.max_cuts = static_cast<int>(r.integer("max_cuts", 0, 60).value_or(10));
+  m.forcing = r.choice<Forcing>("forcing", {{"fixed", Forcing::Fixed},
+                                            {"eisenstat-walker", Forcing::EisenstatWalker}})
+                  .value_or(Forcing::EisenstatWalker);
+  m.preconditioner = r.choice<Preconditioner>(
+                          "preconditioner",
+                          {{"none", Preconditioner::None}, {"diagonal", Preconditioner::Diagonal}})
+                         .value_or(m.formulation == Formulation::Velocity ? Preconditioner::Diagonal
+                                                                          : Preconditioner::None);
+  r.finish();
+}
+
 void read_solver(Reader& r, Scene& s) {
   SolverSpec& v = s.solver;
+  v.type = r.choice<SolverType>(
+                "type", {{"explicit", SolverType::Explicit}, {"implicit", SolverType::Implicit}})
+               .value_or(SolverType::Explicit);
+  if (auto t = r.table(
+          "implicit", {"theta", "formulation", "krylov", "newton_tolerance", "linear_tolerance",
+                       "derivative_step", "gmres_basis", "gmres_restarts", "max_krylov",
+                       "max_newton", "max_line_search", "dt_initial_multiple", "dt_target_multiple",
+                       "ramp", "cut", "max_cuts", "forcing", "preconditioner"})) {
+    if (v.type != SolverType::Implicit)
+      r.fail("implicit", "is used only with solver.type = \"implicit\"");
+    read_implicit(*t, v.implicit);
+  }
+  if (v.type == SolverType::Implicit && r.has("scheme"))
+    r.fail("scheme",
+           "is for the explicit solver; the implicit one takes solver.implicit.formulation "
+           "(\"velocity\" or \"momentum\")");
   v.scheme =
       r.choice<Scheme>("scheme",
                        {{"USF", Scheme::USF}, {"USL", Scheme::USL}, {"MUSL", Scheme::MUSL}}, true)
@@ -956,10 +1016,11 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
     read_boundary(*b, s);
   }
   {
-    Reader v = top.required_table("solver",
-                                  {"scheme", "cfl", "end_time", "dt_max", "gravity", "on_exit",
-                                   "energy_growth_limit", "max_steps", "bulk_viscosity"},
-                                  "end_time is required");
+    Reader v = top.required_table(
+        "solver",
+        {"scheme", "cfl", "end_time", "dt_max", "gravity", "on_exit", "energy_growth_limit",
+         "max_steps", "bulk_viscosity", "type", "implicit"},
+        "end_time is required");
     read_solver(v, s);
   }
   if (auto o = top.table("output", {"frames", "history_interval", "fields", "precision"})) {

@@ -125,7 +125,47 @@ enum class Scheme { USF, USL, MUSL };
 /// What happens to a particle that leaves the domain.
 enum class OnExit { Stop, Remove };
 
+/// Which solver advances the scene in time.
+enum class SolverType { Explicit, Implicit };
+/// Implicit unknowns: grid velocities (symmetric Jacobian, 001 section 2.4) or grid momenta
+/// (non-symmetric, 001 section 3.2).
+enum class Formulation { Velocity, Momentum };
+/// Krylov method of the Newton step: conjugate gradients (symmetric) or GMRES.
+enum class KrylovMethod { CG, GMRES };
+/// Linear tolerance of each Newton step: fixed, or Eisenstat-Walker (choice 2).
+enum class Forcing { Fixed, EisenstatWalker };
+/// Preconditioner of the Krylov solve: none, or the Jacobian's diagonal estimated from the
+/// lumped mass and the elastic stiffness.
+enum class Preconditioner { None, Diagonal };
+
+/// The implicit solver (001, sections 2.4 and 3.2): the theta-scheme of eq. 2.4.1 solved by
+/// matrix-free Newton-Krylov with a backtracking line search. Defaults are the seed's.
+struct ImplicitSpec {
+  double theta = 1.0;  ///< mu of (001, eq. 2.4.1): 0 explicit, 1 fully implicit
+  Formulation formulation = Formulation::Momentum;
+  KrylovMethod krylov = KrylovMethod::GMRES;  ///< default: CG for velocity, GMRES for momentum
+  double newton_tolerance = 1e-5;     ///< on ||F||_2 of the dimensionless residual (001 s. 3.2.2)
+  double linear_tolerance = 1e-3;     ///< Krylov: ||J s + F|| <= eta ||F|| (fixed forcing)
+  double derivative_step = 1e-5;      ///< h of the directional difference (001, eq. 2.4.18)
+  int gmres_basis = 20;               ///< Krylov vectors kept by GMRES (001, section 3.2.4)
+  int gmres_restarts = 0;             ///< restarts after a full basis (0: use the basis once)
+  int max_krylov = 200;               ///< CG iterations per Newton step, at most
+  int max_newton = 25;                ///< Newton iterations per step before the step is cut
+  int max_line_search = 8;            ///< halvings of a Newton step before it counts as failed
+  double dt_initial_multiple = 1.0;   ///< first step, in explicit (CFL) steps
+  double dt_target_multiple = 100.0;  ///< largest step, in explicit steps
+  double ramp = 0.2;                  ///< growth of the step per step (001 Tables 1-6: 20%)
+  double cut = 0.5;                   ///< factor on the step after a failed Newton solve
+  int max_cuts = 10;                  ///< cuts of one step before the run stops (exit 3)
+  Forcing forcing = Forcing::EisenstatWalker;  ///< measured to win: examples/implicit/results.md
+  /// Default by measurement too: diagonal for the velocity formulation (CG), none for the
+  /// momentum formulation (GMRES), where the elastic diagonal slowed the plastic upsetting.
+  Preconditioner preconditioner = Preconditioner::None;
+};
+
 struct SolverSpec {
+  SolverType type = SolverType::Explicit;
+  ImplicitSpec implicit;  ///< used when type is Implicit
   Scheme scheme = Scheme::MUSL;
   double cfl = 0.5;                   ///< dt = cfl * h / max(c + |v|)
   double end_time = 0;                ///< s

@@ -1,0 +1,135 @@
+// The V7 examples (examples/implicit) with the implicit solver through the whole pipeline,
+// against analytic values or the explicit solver's (reference values and tolerances, with
+// where they come from, in implicit_v7.toml).
+#include <gtest/gtest.h>
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "cli/run_command.hpp"
+
+namespace mpm {
+namespace {
+
+using namespace mpm::testing;
+namespace fs = std::filesystem;
+
+/// Rows of a CSV with a header (lines starting with # skipped), by column name.
+std::vector<std::map<std::string, double>> csv(const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  std::vector<std::string> names;
+  std::vector<std::map<std::string, double>> rows;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream f(line);
+    std::string cell;
+    std::vector<std::string> cells;
+    while (std::getline(f, cell, ',')) cells.push_back(cell);
+    if (names.empty()) {
+      names = cells;
+      continue;
+    }
+    std::map<std::string, double> row;
+    for (std::size_t k = 0; k < cells.size() && k < names.size(); ++k)
+      row[names[k]] = std::stod(cells[k]);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+struct Case {
+  toml::table ref;
+  fs::path dir, stream;
+};
+
+/// Runs the case's scene with its --set overrides; the stream is dir/run.mpm.
+Case run_case(const std::string& name) {
+  Case c;
+  const toml::table all =
+      toml::parse_file((fs::path(__FILE__).parent_path() / "implicit_v7.toml").string());
+  c.ref = *all[name].as_table();
+  c.dir = temp_dir("implicit_v7_" + name);
+  c.stream = c.dir / "run.mpm";
+  std::string sets;
+  for (const auto& s : *c.ref["sets"].as_array()) sets += " --set " + *s.value<std::string>();
+  const fs::path scene = fs::path(MPM_EXAMPLES) / c.ref["scene"].value_or(std::string());
+  const Result r = run(prep + " " + scene.string() + " | " + runner +
+                           " --threads 1 --progress none --set output.frames=1" + sets + " -o " +
+                           c.stream.string(),
+                       c.dir);
+  EXPECT_EQ(r.status, 0) << r.err;
+  return c;
+}
+
+/// The deformable particles of the last frame.
+std::vector<std::map<std::string, double>> material(const Case& c) {
+  const Result r =
+      run(post + " particles " + c.stream.string() + " --columns x,sigma,material", c.dir);
+  EXPECT_EQ(r.status, 0) << r.err;
+  auto rows = csv(r.out);
+  std::erase_if(rows, [](auto& p) { return p["material"] == 255; });
+  return rows;
+}
+
+void bar(const std::string& name) {
+  const Case c = run_case(name);
+  const auto rows = material(c);
+  ASSERT_EQ(rows.size(), 36u);
+  double sum = 0, lo = 1e300, hi = -1e300;
+  for (auto& p : rows) {
+    sum += p.at("sigma_0");
+    lo = std::min(lo, p.at("sigma_0"));
+    hi = std::max(hi, p.at("sigma_0"));
+  }
+  const double mean = sum / rows.size(), expect = c.ref["sigma_xx"].value_or(0.0);
+  EXPECT_NEAR(mean, expect, c.ref["tolerance"].value_or(0.0) * expect);
+  EXPECT_LT((hi - lo) / mean, c.ref["spread"].value_or(0.0)) << "uniform along the bar";
+}
+
+TEST(RegressionImplicit, ElasticBarV7) {
+  bar("elastic_bar");
+}
+TEST(RegressionImplicit, PlasticBarV7) {
+  bar("plastic_bar");
+}
+
+TEST(RegressionImplicit, CollidingDisksV7) {
+  const Case c = run_case("disks");
+  const Result r = run(post + " history " + c.stream.string() + " --columns time,total", c.dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = csv(r.out);
+  ASSERT_GT(rows.size(), 100u);
+  const double lost = 1 - rows.back().at("total") / rows.front().at("total");
+  EXPECT_NEAR(lost, c.ref["energy_lost"].value_or(0.0), c.ref["tolerance"].value_or(0.0));
+  for (auto& row : rows) EXPECT_LE(row.at("total"), rows.front().at("total") * (1 + 1e-9));
+}
+
+TEST(RegressionImplicit, UpsettingV7) {
+  const Case c = run_case("upsetting");
+  double r_max = 0;
+  for (auto& p : material(c)) r_max = std::max(r_max, p.at("x_0"));
+  const double r_ref = c.ref["r_max"].value_or(0.0);
+  EXPECT_NEAR(r_max, r_ref, c.ref["r_tolerance"].value_or(0.0) * r_ref);
+  // Load: time-weighted mean over the last 0.5 mm of platen travel (1 m/s: the last 0.5 ms).
+  const Result r =
+      run(post + " history " + c.stream.string() + " --columns time,dt,force_platen_y", c.dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = csv(r.out);
+  const double t_end = rows.back().at("time");
+  double impulse = 0, span = 0;
+  for (auto& row : rows)
+    if (row.at("time") > t_end - 0.5e-3 && row.at("dt") > 0) {
+      impulse += row.at("force_platen_y") * row.at("dt");
+      span += row.at("dt");
+    }
+  ASSERT_GT(span, 0);
+  const double load = impulse / span, load_ref = c.ref["load"].value_or(0.0);
+  EXPECT_NEAR(load, load_ref, c.ref["load_tolerance"].value_or(0.0) * load_ref);
+}
+
+}  // namespace
+}  // namespace mpm
