@@ -164,6 +164,9 @@ class GradedGrid {
     }
     return false;
   }
+  /// Lower corner (m) and size (m) of a cell.
+  Vec<D> cell_origin(std::int64_t key) const { return node_position(cells_[key].corner[0]); }
+  double cell_h(std::int64_t key) const { return level_[cells_[key].level].h; }
   /// Position of a node, m.
   Vec<D> node_position(std::int64_t n) const { return origin_ + h_fine_ * node_ijk_[n].template cast<double>(); }
   /// True for a node that is an optional node of some cell (a hanging node).
