@@ -4,6 +4,8 @@
 // keeps the leapfrog energy balance; particles stay in cell order.
 #include <gtest/gtest.h>
 
+#include <cstring>
+
 #include "fixtures.hpp"
 #include "mpm/graded_solver.hpp"
 
@@ -216,6 +218,65 @@ TEST(GradedSolver, PulseThroughLevelInterfacesKeepsEnergy) {
   // Cell order: the bins of the last sort are in increasing key order.
   const auto& bins = solver.binning().bins();
   for (std::size_t b = 1; b < bins.size(); ++b) ASSERT_LT(bins[b - 1].key, bins[b].key);
+}
+
+}  // namespace
+}  // namespace mpm
+
+namespace mpm {
+namespace {
+
+/// Appends the particles of b to a (same columns).
+void append(ColumnStore& a, const ColumnStore& b) {
+  const std::size_t n = a.size();
+  a.resize(n + b.size());
+  for (const Column& c : b.columns()) {
+    Column& d = a.at(c.info().name);
+    std::memcpy(d.data() + n * c.info().element_bytes(), c.data(), c.bytes());
+  }
+}
+
+// Adaptive placement: a level-2 box that follows a projectile (LevelSpec::follow). The box
+// moves with the projectile's mass centre in whole level-1 cells, the grid is rebuilt, and the
+// target's coarse particles the moving box reaches split. Nothing touches the projectile yet,
+// so momentum stays exactly (to rounding, 1e-12) what it was, and mass too.
+TEST(GradedFollow, BoxMovesWithTheProjectileAndSplitsWhatItReaches) {
+  const double h = 1e-3, rho = 7800, v = 1000;
+  Scene s = scene_with(elastic(200e9, 0.3, rho), 2, h, 1.0);
+  BodySpec target = s.bodies[0];
+  target.name = "target";
+  s.bodies.push_back(target);
+  s.grid.domain_given = true;
+  LevelSpec box = level_box(2, Vec3(1e-3, 0, 0), Vec3(8e-3, 8e-3, 0));
+  box.follow = 0;
+  s.grid.levels.push_back(box);
+  const Lattice lat = lattice(2, Vec3::Zero(), h, {40, 8, 1});
+  ColumnStore cols = block<2>(lat, IVec<2>(2, 2), IVec<2>(5, 6), 2, rho,
+                              [&](const Vec<2>&) { return Vec<2>(v, 0); });
+  ColumnStore far = block<2>(lat, IVec<2>(13, 0), IVec<2>(30, 8), 2, rho,
+                             [](const Vec<2>&) { return Vec<2>::Zero(); });
+  std::fill(far.get<std::uint8_t>(col::body), far.get<std::uint8_t>(col::body) + far.size(), 1);
+  append(cols, far);
+  auto* id = cols.get<std::uint32_t>(col::id);
+  for (std::size_t i = 0; i < cols.size(); ++i) id[i] = std::uint32_t(i);
+  GradedSolver<2> solver(s, GradedGrid<2>(lat, s), cols);
+  all_coarse(cols);
+  const double p0 = solver.balance().momentum[0];
+  const long rev0 = solver.grid().revision();
+  while (solver.time() < 7e-6) solver.step(std::min(solver.stable_dt(), 7e-6 - solver.time()));
+  EXPECT_NEAR(solver.grid().box_offset()[0], v * solver.time(), 0.5e-3 + 1e-9);  // nearest cell
+  EXPECT_NEAR(solver.grid().box_offset()[1], 0.0, 1e-12);
+  EXPECT_GE(solver.grid().revision() - rev0, 6);  // rebuilt at each whole cell
+  EXPECT_GT(solver.splits(), 0);                  // target particles reached by the box
+  EXPECT_NEAR(solver.balance().momentum[0], p0, 1e-12 * p0);
+  // The split particles are the target's, inside the moved box.
+  const ParticleView<2> p = view<2>(cols);
+  const auto* level = cols.get<std::uint8_t>(col::level);
+  for (std::size_t i = 0; i < p.n; ++i)
+    if (p.body[i] == 1 && level[i] == 2) {
+      ASSERT_GE(p.x[i][0], 13e-3);
+      ASSERT_LE(p.x[i][0], 8e-3 + solver.grid().box_offset()[0]);
+    }
 }
 
 }  // namespace
