@@ -57,13 +57,17 @@ GradedGrid<D>::GradedGrid(const Lattice& lattice, const Scene& scene)
   }
   levels_ = 1;
   for (const LevelSpec& s : scene.grid.levels) levels_ = std::max(levels_, s.level);
+  if (levels_ > 12) throw std::logic_error("graded grid: at most 12 levels");
   level_.resize(levels_ + 1);
   for (int l = 1; l <= levels_; ++l) {
     Level& lv = level_[l];
     lv.scale = std::ldexp(1.0, l - 1);
     lv.h = std::ldexp(h1_, -(l - 1));
     lv.inv_h = inv_h1_ * lv.scale;
+    inv_h_[l] = lv.inv_h;
   }
+  std::int64_t st = 1;
+  for (int a = 0; a < D; ++a) stride1_[a] = st, st *= cells1_[a];
   h_fine_ = level_[levels_].h;
   // Slab axis: the domain's longest (ties to the highest axis), as UniformGrid.
   slab_ = D - 1;
@@ -252,36 +256,47 @@ void GradedGrid<D>::build() {
         for_cells(blo / 2, bhi / 2, [&](const IVec<D>& c) { parent.cell[index(parent, c)] = kRefined; });
       }
 
-  // Cell keys: level-1 cells with the slab axis slowest, the leaves inside each depth first.
+  // Cell keys: level-1 cells with the slab axis slowest, the leaves inside each depth first;
+  // locate's tree on the way.
   cells_.clear();
   std::vector<IVec<D>> cpos;  // leaf position in cells of its level
   {
+    std::size_t refined = 0;
+    for (int l = 1; l < L; ++l)
+      refined += std::size_t(std::count(level_[l].cell.begin(), level_[l].cell.end(), kRefined));
+    root_.assign(level_[1].cell.size(), -1);
+    tree_.assign(refined << D, -1);  // sized once: the slots below stay valid
+    std::size_t next = 0;
     int order[D];
     int k = 0;
     for (int a = 0; a < D; ++a)
       if (a != slab_) order[k++] = a;
     order[D - 1] = slab_;  // slowest
-    auto visit = [&](auto&& self, int l, const IVec<D>& c, int layer) -> void {
+    auto visit = [&](auto&& self, int l, const IVec<D>& c, int layer, std::int32_t& slot) -> void {
       Level& lv = level_[l];
       const std::int64_t idx = index(lv, c);
       if (lv.cell[idx] == kRefined) {
+        const std::size_t t = next++;
+        slot = std::int32_t(-1 - std::int64_t(t));
         for (int bits = 0; bits < kCorners<D>; ++bits) {
           IVec<D> child;
           for (int a = 0; a < D; ++a) child[a] = 2 * c[a] + ((bits >> a) & 1);
-          self(self, l + 1, child, layer);
+          self(self, l + 1, child, layer, tree_[(t << D) + bits]);
         }
         return;
       }
       Cell cell;
       cell.level = std::uint8_t(l);
       cell.layer = layer;
-      lv.cell[idx] = std::int32_t(cells_.size());
+      slot = lv.cell[idx] = std::int32_t(cells_.size());
       cells_.push_back(cell);
       cpos.push_back(c);
     };
     IVec<D> c = IVec<D>::Zero();
     while (true) {
-      visit(visit, 1, c, c[slab_]);
+      std::int64_t idx1 = 0;
+      for (int a = 0; a < D; ++a) idx1 += c[a] * stride1_[a];
+      visit(visit, 1, c, c[slab_], root_[idx1]);
       int q = 0;
       while (q < D && ++c[order[q]] == cells1_[order[q]]) c[order[q]] = 0, ++q;
       if (q == D) break;
@@ -392,6 +407,10 @@ void GradedGrid<D>::build() {
       if (node_ijk_[n][axis] != plane) continue;
       (type == BoundaryType::Fixed ? fixed_ : slip_).push_back({std::int64_t(n), face});
     }
+
+  info_.resize(cells_.size());
+  for (std::size_t key = 0; key < cells_.size(); ++key)
+    info_[key] = cells_[key].mask | (std::uint32_t(cells_[key].level) << kLevelShift);
 
   const std::size_t nn = node_ijk_.size();
   m.resize(nn);

@@ -75,32 +75,35 @@ class GradedGrid {
   // Location ---------------------------------------------------------------------------------
   /// Cell key and position in the cell (fractions of its size, in [0,1)) of a point inside
   /// the domain, searching the levels from the finest to the coarsest (004, section 3.2).
+  /// The search descends from the level-1 cell through the refined cells (a 2^D-tree), which
+  /// visits the levels from coarse to fine but finds the finest cell holding the point, as
+  /// searching the levels from fine to coarse would. Halving the position is exact, so a point
+  /// on an interface goes where the half-open cells [lo, hi) of every level put it.
   void locate(const Vec<D>& x, std::int64_t& key, Vec<D>& xi) const {
-    const Vec<D> r1 = (x - origin_) * inv_h1_;
-    for (int l = levels_; l >= 1; --l) {
-      const Level& lv = level_[l];
-      Vec<D> r = r1 * lv.scale;  // exact: scale is a power of two
-      std::int64_t idx = 0;
-      bool inside = true;
-      for (int a = 0; a < D; ++a) {
-        const double f = std::floor(r[a]);
-        const std::int64_t c = std::int64_t(f) - lv.lo[a];
-        if (c < 0 || c >= lv.n[a]) {
-          inside = false;
-          break;
-        }
-        idx += c * lv.stride[a];
-        r[a] -= f;
+    Vec<D> r = (x - origin_) * inv_h1_;
+    std::int64_t idx = 0;
+    for (int a = 0; a < D; ++a) {
+      const double f = std::floor(r[a]);
+      const std::int64_t c = std::int64_t(f);
+      if (c < 0 || c >= cells1_[a]) {
+        key = -1;
+        xi.setZero();
+        return;
       }
-      if (!inside) continue;
-      const std::int32_t id = lv.cell[idx];
-      if (id < 0) continue;
-      key = id;
-      xi = r;
-      return;
+      idx += c * stride1_[a];
+      r[a] -= f;
     }
-    key = -1;
-    xi.setZero();
+    std::int32_t v = root_[idx];
+    while (v < 0) {  // a refined cell: down to the child holding the point
+      int bits = 0;
+      for (int a = 0; a < D; ++a) {
+        r[a] *= 2.0;
+        if (r[a] >= 1.0) r[a] -= 1.0, bits |= 1 << a;
+      }
+      v = tree_[(std::size_t(-1 - v) << D) + bits];
+    }
+    key = v;
+    xi = r;
   }
   /// Where a point is (the grid is all window); key and xi are set when it is inside.
   Where where(const Vec<D>& x, std::int64_t& key, Vec<D>& xi) const {
@@ -119,15 +122,15 @@ class GradedGrid {
   }
   /// Shape functions and gradients (1/m) at position xi of a cell, in cell_nodes order.
   void shape(std::int64_t key, const Vec<D>& xi, double* N, Vec<D>* G) const {
-    const Cell& c = cells_[key];
-    const double inv_h = level_[c.level].inv_h;
-    if (c.mask == 0) shape_functions<D>(xi, inv_h, N, G);
-    else transition_shape<D>(c.mask, xi, inv_h, N, G);
+    const std::uint32_t info = info_[key], mask = info & kMaskBits;
+    const double inv_h = inv_h_[info >> kLevelShift];
+    if (mask == 0) shape_functions<D>(xi, inv_h, N, G);
+    else transition_shape<D>(mask, xi, inv_h, N, G);
   }
   void values(std::int64_t key, const Vec<D>& xi, double* N) const {
-    const Cell& c = cells_[key];
-    if (c.mask == 0) shape_values<D>(xi, N);
-    else transition_shape<D>(c.mask, xi, 1.0, N, nullptr);
+    const std::uint32_t mask = info_[key] & kMaskBits;
+    if (mask == 0) shape_values<D>(xi, N);
+    else transition_shape<D>(mask, xi, 1.0, N, nullptr);
   }
   std::size_t key_count() const { return cells_.size(); }
   /// Slab layer of a key: the position of its level-1 ancestor along the slab axis.
@@ -260,6 +263,15 @@ class GradedGrid {
 
   std::vector<Level> level_;  ///< index 1..levels_
   std::vector<Cell> cells_;
+  // The hot path: locate's 2^D-tree (a level-1 cell or a child slot holds a leaf's key, or
+  // -1 - t for a refined cell whose children are tree_[t 2^D ...]), and per key the mask and
+  // the level in one word.
+  static constexpr std::uint32_t kMaskBits = (1u << 24) - 1;
+  static constexpr int kLevelShift = 24;
+  std::array<std::int64_t, D> stride1_{};
+  std::vector<std::int32_t> root_, tree_;
+  std::vector<std::uint32_t> info_;
+  std::array<double, 16> inv_h_{};
   std::vector<std::int32_t> optional_;
   std::vector<IVec<D>> node_ijk_;  ///< node positions in finest cells from the origin
   std::vector<std::uint8_t> hanging_;
