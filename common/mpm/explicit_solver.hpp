@@ -141,6 +141,7 @@ class ExplicitSolver {
   KernelTimers timers_;
   std::uint32_t next_id_ = 0;  ///< id of the next particle a split creates (0: not yet known)
   long split_count_ = 0;       ///< particles split so far
+  int split_wait_ = 0;         ///< steps the pending splits have waited for a sort
 };
 
 /// The uniform-grid solver of a scene: builds the window grid on the scene's lattice.

@@ -66,8 +66,7 @@ GradedGrid<D>::GradedGrid(const Lattice& lattice, const Scene& scene)
     lv.inv_h = inv_h1_ * lv.scale;
     inv_h_[l] = lv.inv_h;
   }
-  std::int64_t st = 1;
-  for (int a = 0; a < D; ++a) stride1_[a] = st, st *= cells1_[a];
+  wn_ = cells1_;  // the whole domain first: the boxes are checked on it
   h_fine_ = level_[levels_].h;
   // Slab axis: the domain's longest (ties to the highest axis), as UniformGrid.
   slab_ = D - 1;
@@ -131,12 +130,20 @@ GradedGrid<D>::GradedGrid(const Lattice& lattice, const Scene& scene)
                "boxes that follow a body must be one per level (level " +
                    std::to_string(boxes_[k].level) + " has two)");
   }
-  build();
+  build(true);
+  revision_ = 1;
 }
 
 template <int D>
-void GradedGrid<D>::build() {
+bool GradedGrid<D>::build(bool validate) {
   const int L = levels_;
+  ++builds_;
+  // Slab axis: the window's longest (ties to the highest axis), as UniformGrid.
+  slab_ = D - 1;
+  for (int a = D - 2; a >= 0; --a)
+    if (wn_[a] > wn_[slab_]) slab_ = a;
+  std::int64_t st = 1;
+  for (int a = 0; a < D; ++a) stride1_[a] = st, st *= wn_[a];
   // Box extents at the current offset.
   for (Box& b : boxes_) {
     const int s = 1 << (b.level - 1);
@@ -145,10 +152,14 @@ void GradedGrid<D>::build() {
       b.xmax[a] = origin_[a] + level_[b.level].h * double(b.hi[a] + offset_[a] * s);
     }
   }
+  // A box's cells at the current offset, clipped to the window (empty: hi <= lo somewhere).
   auto shifted = [&](const Box& b, IVec<D>& lo, IVec<D>& hi) {
     const int s = 1 << (b.level - 1);
-    lo = b.lo + offset_ * s;
-    hi = b.hi + offset_ * s;
+    lo = (b.lo + offset_ * s).cwiseMax(wlo_ * s);
+    hi = (b.hi + offset_ * s).cwiseMin((wlo_ + wn_) * s);
+    for (int a = 0; a < D; ++a)
+      if (hi[a] <= lo[a]) return false;
+    return true;
   };
   auto index = [](const Level& lv, const IVec<D>& c) {
     std::int64_t idx = 0;
@@ -180,8 +191,8 @@ void GradedGrid<D>::build() {
     }
   };
 
-  // Level regions: level 1 is the domain; level l the union of its boxes.
-  set_layout(level_[1], IVec<D>::Zero(), cells1_);
+  // Level regions: level 1 is the window; level l the union of its boxes.
+  set_layout(level_[1], wlo_, wlo_ + wn_);
   std::fill(level_[1].cell.begin(), level_[1].cell.end(), 0);
   for (int l = 2; l <= L; ++l) {
     IVec<D> lo = IVec<D>::Constant(std::numeric_limits<int>::max());
@@ -190,24 +201,25 @@ void GradedGrid<D>::build() {
     for (const Box& b : boxes_)
       if (b.level == l) {
         IVec<D> blo, bhi;
-        shifted(b, blo, bhi);
+        if (!shifted(b, blo, bhi)) continue;
         lo = lo.cwiseMin(blo);
         hi = hi.cwiseMax(bhi);
         any = true;
       }
-    if (!any) {
+    if (!any && validate) {
       for (const Box& b : boxes_)
         if (b.level > l)
           fail(b, "level", "a level-" + std::to_string(b.level) + " box needs level-" +
                                std::to_string(l) + " boxes around it (levels are nested)");
     }
+    if (!any) lo = hi = IVec<D>::Zero();
     Level& lv = level_[l];
     set_layout(lv, lo, hi);
     for (const Box& b : boxes_)
       if (b.level == l) {
         IVec<D> blo, bhi;
-        shifted(b, blo, bhi);
-        for_cells(blo, bhi, [&](const IVec<D>& c) { lv.cell[index(lv, c)] = 0; });
+        if (shifted(b, blo, bhi))
+          for_cells(blo, bhi, [&](const IVec<D>& c) { lv.cell[index(lv, c)] = 0; });
       }
   }
   // Nesting (each box inside the coarser region) and 2:1 balance: a level-l box (l >= 3)
@@ -215,6 +227,7 @@ void GradedGrid<D>::build() {
   // except where it meets the domain's faces, so that cells touching at a face, an edge or a
   // corner differ by at most one level.
   for (const Box& b : boxes_) {
+    if (!validate) break;  // checked on the whole domain; clipping keeps the rules
     const int l = b.level;
     IVec<D> blo, bhi;
     shifted(b, blo, bhi);
@@ -251,7 +264,7 @@ void GradedGrid<D>::build() {
     for (const Box& b : boxes_)
       if (b.level == l) {
         IVec<D> blo, bhi;
-        shifted(b, blo, bhi);
+        if (!shifted(b, blo, bhi)) continue;
         Level& parent = level_[l - 1];
         for_cells(blo / 2, bhi / 2, [&](const IVec<D>& c) { parent.cell[index(parent, c)] = kRefined; });
       }
@@ -292,13 +305,13 @@ void GradedGrid<D>::build() {
       cells_.push_back(cell);
       cpos.push_back(c);
     };
-    IVec<D> c = IVec<D>::Zero();
+    IVec<D> c = wlo_;
     while (true) {
       std::int64_t idx1 = 0;
-      for (int a = 0; a < D; ++a) idx1 += c[a] * stride1_[a];
-      visit(visit, 1, c, c[slab_], root_[idx1]);
+      for (int a = 0; a < D; ++a) idx1 += (c[a] - wlo_[a]) * stride1_[a];
+      visit(visit, 1, c, c[slab_] - wlo_[slab_], root_[idx1]);
       int q = 0;
-      while (q < D && ++c[order[q]] == cells1_[order[q]]) c[order[q]] = 0, ++q;
+      while (q < D && ++c[order[q]] == wlo_[order[q]] + wn_[order[q]]) c[order[q]] = wlo_[order[q]], ++q;
       if (q == D) break;
     }
   }
@@ -373,6 +386,7 @@ void GradedGrid<D>::build() {
     if (cell.mask == 0) continue;
     auto [it, fresh] = mask_min.try_emplace(cell.mask, 0.0);
     if (fresh) it->second = transition_min_value<D>(cell.mask);
+    if (it->second < -1e-12 && !validate) return false;  // clipped badly: use a larger window
     if (it->second < -1e-12) {
       // Name the finer box nearest to the cell.
       Vec<D> centre;
@@ -419,12 +433,54 @@ void GradedGrid<D>::build() {
   if (!v_remap.empty()) v_remap.resize(nn);
   if (!rigid.empty()) rigid.resize(nn);
   built_offset_ = offset_;
-  ++revision_;
+  return true;
 }
 
 template <int D>
-void GradedGrid<D>::fit(const Vec<D>*, std::size_t, int) {
-  if (offset_ != built_offset_) build();
+void GradedGrid<D>::fit(const Vec<D>* x, std::size_t n, int margin) {
+  // Level-1 cells of the particles (a parallel min/max, as UniformGrid::fit).
+  IVec<D> lo = cells1_, hi = IVec<D>::Constant(-1);
+#pragma omp parallel
+  {
+    IVec<D> tlo = cells1_, thi = IVec<D>::Constant(-1);
+#pragma omp for schedule(static) nowait
+    for (std::size_t i = 0; i < n; ++i)
+      for (int a = 0; a < D; ++a) {
+        const int c = int(std::floor((x[i][a] - origin_[a]) * inv_h1_));
+        tlo[a] = std::min(tlo[a], c);
+        thi[a] = std::max(thi[a], c);
+      }
+#pragma omp critical
+    {
+      lo = lo.cwiseMin(tlo);
+      hi = hi.cwiseMax(thi);
+    }
+  }
+  if (n == 0) lo.setZero(), hi.setZero();
+  auto clamp = [&](int pad, IVec<D>& wlo, IVec<D>& whi) {
+    for (int a = 0; a < D; ++a) {
+      wlo[a] = std::clamp(lo[a] - pad, 0, cells1_[a]);
+      whi[a] = std::clamp(hi[a] + 1 + pad, 0, cells1_[a]);
+    }
+  };
+  IVec<D> need_lo, need_hi, cur_hi = wlo_ + wn_;
+  clamp(margin, need_lo, need_hi);
+  const bool inside = (need_lo.array() >= wlo_.array()).all() && (need_hi.array() <= cur_hi.array()).all();
+  // Shrink when the window holds more than twice the cells the particles need (with 3 around).
+  IVec<D> roomy_lo, roomy_hi;
+  clamp(3, roomy_lo, roomy_hi);
+  const double want = (roomy_hi - roomy_lo).template cast<double>().prod();
+  const bool oversized = wn_.template cast<double>().prod() > 2 * want;
+  if (inside && !oversized && offset_ == built_offset_) return;
+  const bool moved = offset_ != built_offset_;
+  wlo_ = roomy_lo;
+  wn_ = roomy_hi - roomy_lo;
+  if (!build(false)) {  // the clipped boxes make a bad transition cell: the whole domain
+    wlo_.setZero();
+    wn_ = cells1_;
+    build(false);
+  }
+  if (moved) ++revision_;
 }
 
 template <int D>
@@ -510,6 +566,14 @@ std::size_t GradedGrid<D>::hanging_nodes() const {
 
 template <int D>
 GridMesh GradedGrid<D>::mesh(std::int64_t step, double time) const {
+  if (wlo_ != IVec<D>::Zero() || wn_ != cells1_) {
+    GradedGrid<D> whole = *this;  // the same boxes over the whole domain
+    whole.m.clear(), whole.v.clear(), whole.a.clear(), whole.v_remap.clear(), whole.rigid.clear();
+    whole.wlo_.setZero();
+    whole.wn_ = cells1_;
+    whole.build(false);
+    return whole.mesh(step, time);
+  }
   GridMesh g;
   g.dim = D;
   g.levels = levels_;

@@ -13,7 +13,9 @@
 /// layers that are not adjacent never share a node: the coloured, lock-free scatter of
 /// binning.hpp works unchanged. A point is located by searching the levels from fine to coarse.
 ///
-/// The grid has no window: node arrays cover the whole domain. Level boxes may follow a body
+/// As UniformGrid, cells and nodes exist only in a window of level-1 cells around the particles
+/// (the level boxes clipped to it); fit() rebuilds the grid when the particles leave the window
+/// or it has grown much larger than they need. Level boxes may follow a body
 /// (LevelSpec::follow): the solver reports the body's mass centre every step and the grid is
 /// rebuilt at the next sort when the boxes moved by a whole level-1 cell.
 #include <array>
@@ -68,8 +70,8 @@ class GradedGrid {
   /// transition cell would get negative shape functions.
   GradedGrid(const Lattice& lattice, const Scene& scene);
 
-  /// Rebuilds the grid when followed boxes moved (see follow); otherwise nothing: the grid
-  /// spans the whole domain.
+  /// Fits the window to the level-1 cells of n particles (with `margin` cells around them;
+  /// a rebuild leaves 3), and rebuilds the grid when the window or the followed boxes moved.
   void fit(const Vec<D>* x, std::size_t n, int margin = 1);
 
   // Location ---------------------------------------------------------------------------------
@@ -84,8 +86,8 @@ class GradedGrid {
     std::int64_t idx = 0;
     for (int a = 0; a < D; ++a) {
       const double f = std::floor(r[a]);
-      const std::int64_t c = std::int64_t(f);
-      if (c < 0 || c >= cells1_[a]) {
+      const std::int64_t c = std::int64_t(f) - wlo_[a];
+      if (c < 0 || c >= wn_[a]) {
         key = -1;
         xi.setZero();
         return;
@@ -108,7 +110,12 @@ class GradedGrid {
   /// Where a point is (the grid is all window); key and xi are set when it is inside.
   Where where(const Vec<D>& x, std::int64_t& key, Vec<D>& xi) const {
     locate(x, key, xi);
-    return key < 0 ? Where::OutsideDomain : Where::Window;
+    if (key >= 0) return Where::Window;
+    for (int a = 0; a < D; ++a) {
+      const double c = std::floor((x[a] - origin_[a]) * inv_h1_);
+      if (!(c >= 0 && c < cells1_[a])) return Where::OutsideDomain;
+    }
+    return Where::OutsideWindow;
   }
   /// Nodes of a cell: its corners in bit order, then its present optional nodes in increasing
   /// number (transition_shape.hpp); returns their count (2^D to kMaxNodes).
@@ -135,7 +142,7 @@ class GradedGrid {
   std::size_t key_count() const { return cells_.size(); }
   /// Slab layer of a key: the position of its level-1 ancestor along the slab axis.
   int layer(std::int64_t key) const { return cells_[key].layer; }
-  int layers() const { return cells1_[slab_]; }
+  int layers() const { return wn_[slab_]; }
   int slab_axis() const { return slab_; }
   /// Length scale of the time step and the bulk viscosity (m): the finest cell's everywhere,
   /// since the time step must hold for the finest cells (004, section 3.4).
@@ -148,7 +155,7 @@ class GradedGrid {
   double level_h(int l) const { return level_[l].h; }
   int cell_level(std::int64_t key) const { return cells_[key].level; }
   std::uint32_t cell_mask(std::int64_t key) const { return cells_[key].mask; }
-  /// The finest level whose region contains x (1 when x lies in no box; 0 outside the domain).
+  /// The finest level whose region contains x (1 when x lies in no box; 0 outside the window).
   int level_at(const Vec<D>& x) const {
     std::int64_t key;
     Vec<D> xi;
@@ -178,10 +185,12 @@ class GradedGrid {
   std::vector<std::size_t> cells_per_level() const;
   std::size_t transition_cells() const;
   std::size_t hanging_nodes() const;
-  /// The grid as written to a GRID record.
+  /// The grid over the whole domain (whatever the window) as written to a GRID record.
   GridMesh mesh(std::int64_t step, double time) const;
-  /// Incremented at every rebuild (the run writes a new GRID record when it changes).
+  /// Incremented when the level boxes move (the run writes a new GRID record then).
   long revision() const { return revision_; }
+  /// Builds so far (window changes and moves).
+  long builds() const { return builds_; }
 
   // Following a body -------------------------------------------------------------------------
   /// The body the level boxes follow, -1 when they are fixed.
@@ -243,7 +252,10 @@ class GradedGrid {
     std::uint8_t level = 1;
   };
 
-  void build();
+  /// Builds cells and nodes in the window [wlo_, wlo_ + wn_). With `validate` (the whole
+  /// domain), checks the boxes and throws InputError; else returns false when clipping the
+  /// boxes to the window would give a transition cell with negative shape functions.
+  bool build(bool validate);
   [[noreturn]] void fail(const Box& b, const std::string& key, const std::string& message) const;
   std::string mm(const Vec<D>& x) const;
 
@@ -259,7 +271,8 @@ class GradedGrid {
   bool have_centre0_ = false;
   Vec<D> centre0_ = Vec<D>::Zero();
   IVec<D> offset_ = IVec<D>::Zero(), built_offset_ = IVec<D>::Zero();
-  long revision_ = 0;
+  IVec<D> wlo_ = IVec<D>::Zero(), wn_ = IVec<D>::Zero();  ///< window, level-1 cells
+  long revision_ = 0, builds_ = 0;
 
   std::vector<Level> level_;  ///< index 1..levels_
   std::vector<Cell> cells_;
