@@ -3,16 +3,20 @@
 //   mpm-post vtk run.mpm -o out/        mpm-post taylor run.mpm --json
 //   mpm-post particles run.mpm --columns x,sigma -o last.csv
 //   mpm-post render run.mpm -o bar.png --field eps_p
+//   mpm-post profile run.mpm --field sigma --component xx --time 9us   (CSV, or --json)
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <optional>
 
 #include "mpm/cli.hpp"
 #include "mpm/error.hpp"
+#include "mpm/graded_grid.hpp"
 #include "mpm/post.hpp"
+#include "mpm/profile.hpp"
 #include "mpm/stream.hpp"
 #include "mpm/units.hpp"
 #include "mpm/version.hpp"
@@ -214,9 +218,27 @@ int cmd_vtk(const std::string& path, const std::string& dir, const std::string& 
     entries.emplace_back(f.time, file);
     write_pvd(entries, (std::filesystem::path(dir) / (name + ".pvd")).string());
   };
+  // Graded grids: each GRID record as <name>_grid_NNNN.vtu, listed by time in <name>_grid.pvd.
+  std::vector<std::pair<double, std::string>> grids;
+  v.grid = [&](std::vector<std::byte>&& payload) {
+    GridMesh mesh;
+    try {
+      mesh = decode_grid(payload);
+    } catch (const StreamError& e) {
+      throw StreamError(input_name(path), e.message());
+    }
+    char file[256];
+    std::snprintf(file, sizeof file, "%s_grid_%04zu.vtu", name.c_str(), grids.size());
+    write_grid_vtu(mesh, (std::filesystem::path(dir) / file).string());
+    grids.emplace_back(mesh.time, file);
+    write_pvd(grids, (std::filesystem::path(dir) / (name + "_grid.pvd")).string());
+  };
   const StreamSummary s = read_stream(path, v);
   std::fprintf(stderr, "mpm-post: wrote %zu frame(s) and %s\n", entries.size(),
                (std::filesystem::path(dir) / (name + ".pvd")).string().c_str());
+  if (!grids.empty())
+    std::fprintf(stderr, "mpm-post: wrote %zu graded grid(s) and %s (cell field 'level')\n",
+                 grids.size(), (std::filesystem::path(dir) / (name + "_grid.pvd")).string().c_str());
   return conclude(path, s, index);
 }
 
@@ -441,10 +463,145 @@ int cmd_particles(const std::string& path, const std::string& out, const std::st
       }
     std::fprintf(f, "\n");
   }
-  if (f != stdout)
-    std::fclose(f);
-  else
+  if (f != stdout) {
+    if (std::fclose(f) != 0) throw IoError("cannot write '" + out + "': " + std::strerror(errno));
+  } else {
     std::fflush(stdout);
+  }
+  return conclude(path, s, std::size_t(index));
+}
+
+// profile ---------------------------------------------------------------------------------
+struct ProfileArgs {
+  std::string output = "-", component = "0", along = "x", from, to, radius, body;
+  std::vector<std::string> times;
+  std::vector<long> frames;
+  ProfileOptions opt;
+  bool json = false;
+};
+
+Vec3 point(const std::string& text, const std::string& option) {
+  std::vector<Quantity> qs;
+  try {
+    qs = parse_vector(text);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(option, std::string(e.what()) + " in '" + text + "'");
+  }
+  if (qs.size() < 2 || qs.size() > 3)
+    throw InputError(option, "expected 2 or 3 components, e.g. \"0 0 0 mm\", got '" + text + "'");
+  Vec3 x = Vec3::Zero();
+  for (std::size_t a = 0; a < qs.size(); ++a) {
+    if (!(qs[a].dim == dim::length) && !(qs[a].dim == dim::none))
+      throw InputError(option, "expected lengths, got '" + text + "'");
+    x[a] = qs[a].value;
+  }
+  return x;
+}
+
+int cmd_profile(const std::string& path, ProfileArgs& a) {
+  ProfileOptions& o = a.opt;
+  o.component = component_index(a.component);
+  if (a.along != "x" && a.along != "y" && a.along != "z")
+    throw InputError("--along", "expected x, y or z, got '" + a.along + "'");
+  o.axis = a.along[0] - 'x';
+  if (a.from.empty() != a.to.empty()) throw InputError(a.from.empty() ? "--from" : "--to", "give both --from and --to");
+  if (!a.from.empty()) o.from = point(a.from, "--from"), o.to = point(a.to, "--to");
+  if (!a.radius.empty()) o.radius = quantity(a.radius, dim::length, "--radius");
+  std::vector<double> want_t;
+  for (const auto& t : a.times) want_t.push_back(quantity(t, dim::time, "--time"));
+  // Per request, the profile of the nearest frame (by time) or of the frame of that index;
+  // default the last frame. Frames are profiled as they stream by (once each, when they are
+  // nearer than any before), so memory stays bounded on pipes.
+  std::vector<std::shared_ptr<Profile>> by_time(want_t.size()), by_index(a.frames.size());
+  std::vector<double> best(want_t.size(), 1e300);
+  std::shared_ptr<Profile> last;
+  std::string scene_text;
+  long index = 0;
+  StreamVisitor v;
+  v.scene = [&](const std::string& t) {
+    scene_text = t;
+    if (!a.body.empty()) {
+      const Scene sc = scene_of(scene_text, path);
+      o.body = sc.body_index(a.body);
+      if (o.body < 0) throw InputError("--body", "no body named '" + a.body + "' in the scene");
+    }
+  };
+  v.frame = [&](Frame&& f) {
+    const long k = index++;
+    const int dim = f.columns.at("x").info().components;
+    std::shared_ptr<Profile> p;
+    auto get = [&]() {
+      if (!p) p = std::make_shared<Profile>(make_profile(f, dim, o));
+      return p;
+    };
+    for (std::size_t r = 0; r < want_t.size(); ++r)
+      if (std::abs(f.time - want_t[r]) < best[r]) best[r] = std::abs(f.time - want_t[r]), by_time[r] = get();
+    for (std::size_t r = 0; r < a.frames.size(); ++r)
+      if (a.frames[r] == k) by_index[r] = get();
+    if (want_t.empty() && a.frames.empty()) last = get();
+  };
+  const StreamSummary s = read_stream(path, v);
+  std::vector<Profile> profiles;
+  for (auto& p : by_time)
+    if (p) profiles.push_back(*p);
+  for (std::size_t r = 0; r < by_index.size(); ++r) {
+    if (!by_index[r]) {
+      std::fprintf(stderr, "mpm-post: error: %s has no frame %ld (it holds %ld)\n", input_name(path).c_str(),
+                   a.frames[r], index);
+      return kExitBadInput;
+    }
+    profiles.push_back(*by_index[r]);
+  }
+  if (last) profiles.push_back(*last);
+  if (profiles.empty()) {
+    std::fprintf(stderr, "mpm-post: error: %s holds no frame to profile\n", input_name(path).c_str());
+    return kExitBadInput;
+  }
+  std::FILE* out = a.output == "-" ? stdout : std::fopen(a.output.c_str(), "w");
+  if (!out) throw IoError("cannot write '" + a.output + "': " + std::strerror(errno));
+  const bool bins = o.bins > 0;
+  if (a.json) {
+    const Profile& p0 = profiles.front();
+    std::fprintf(out, "{\"field\": %s, \"component\": %d, \"unit\": %s, \"from\": [%s, %s, %s], \"to\": [%s, %s, %s], \"profiles\": [",
+                 json_string(o.field).c_str(), o.component, json_string(p0.unit).c_str(),
+                 json_number(p0.from[0]).c_str(), json_number(p0.from[1]).c_str(), json_number(p0.from[2]).c_str(),
+                 json_number(p0.to[0]).c_str(), json_number(p0.to[1]).c_str(), json_number(p0.to[2]).c_str());
+    for (std::size_t k = 0; k < profiles.size(); ++k) {
+      const Profile& p = profiles[k];
+      auto array = [&](const char* name, const std::vector<double>& x) {
+        std::fprintf(out, ", \"%s\": [", name);
+        for (std::size_t i = 0; i < x.size(); ++i) std::fprintf(out, "%s%s", i ? ", " : "", json_number(x[i]).c_str());
+        std::fprintf(out, "]");
+      };
+      std::fprintf(out, "%s{\"time\": %s", k ? ", " : "", json_number(p.time).c_str());
+      array("s", p.s);
+      array("value", p.value);
+      array("weight", p.weight);
+      if (bins) {
+        array("min", p.min);
+        array("max", p.max);
+        std::vector<double> c(p.count.begin(), p.count.end());
+        array("count", c);
+      }
+      std::fprintf(out, "}");
+    }
+    std::fprintf(out, "]}\n");
+  } else {
+    std::fprintf(out, bins ? "time,s,value,min,max,count,weight\n" : "time,s,value,weight\n");
+    for (const Profile& p : profiles)
+      for (std::size_t i = 0; i < p.s.size(); ++i) {
+        if (bins)
+          std::fprintf(out, "%.10g,%.10g,%.10g,%.10g,%.10g,%zu,%.10g\n", p.time, p.s[i], p.value[i], p.min[i],
+                       p.max[i], p.count[i], p.weight[i]);
+        else
+          std::fprintf(out, "%.10g,%.10g,%.10g,%.10g\n", p.time, p.s[i], p.value[i], p.weight[i]);
+      }
+  }
+  if (out != stdout) {
+    if (std::fclose(out) != 0) throw IoError("cannot write '" + a.output + "': " + std::strerror(errno));
+  } else {
+    std::fflush(stdout);
+  }
   return conclude(path, s, std::size_t(index));
 }
 
@@ -567,6 +724,21 @@ int main(int argc, char** argv) {
   debris->add_option("--expect-front", da.expect_front, "reference front, e.g. \"200 mm\"");
   debris->add_option("--expect-width", da.expect_width, "reference width, e.g. \"145 mm\"");
   debris->add_flag("--json", da.json, "print JSON (SI units)");
+  auto* profile = app.add_subcommand("profile", "a field along a line (stress waves, shocks), CSV or JSON");
+  ProfileArgs pa;
+  profile->add_option("input", input, "stream, - for stdin")->capture_default_str();
+  profile->add_option("-o,--output", pa.output, "CSV (or JSON) file, - for stdout")->capture_default_str();
+  profile->add_option("--field", pa.opt.field, "a column (sigma, v, eps_p, ...) or pressure, von_mises, speed")->capture_default_str();
+  profile->add_option("--component", pa.component, "xx, yy, zz, yz, xz, xy (tensors), x, y, z (vectors), an index, or magnitude")->capture_default_str();
+  profile->add_option("--along", pa.along, "the line's direction when --from/--to are not given: x, y or z, over the particles' extent through their centroid")->capture_default_str();
+  profile->add_option("--from", pa.from, "start of the line, e.g. \"0 0 0 mm\"");
+  profile->add_option("--to", pa.to, "end of the line");
+  profile->add_option("--radius", pa.radius, "leave out particles farther than this from the line, e.g. \"1 mm\" (default: none)");
+  profile->add_option("--body", pa.body, "only this body's particles");
+  profile->add_option("--bins", pa.opt.bins, "average in this many equal bins along the line (default: one row per particle)");
+  profile->add_option("--time", pa.times, "the frame nearest this time, e.g. 9us (repeatable)");
+  profile->add_option("--frame", pa.frames, "frame index, 0 = first (repeatable); default: the last frame");
+  profile->add_flag("--json", pa.json, "print JSON (SI units)");
 
   auto* render = app.add_subcommand("render", "PNG picture of a frame, off-screen (works without a display)");
   RenderArgs ra;
@@ -598,6 +770,7 @@ int main(int argc, char** argv) {
     if (*vtk) return cmd_vtk(input, vtk_dir, vtk_name, vtk_every);
     if (*taylor) return cmd_taylor(input, ta);
     if (*debris) return cmd_debris(input, da);
+    if (*profile) return cmd_profile(input, pa);
     if (*render) {
       mpm::ensure_display(argc, argv);  // before reading: a re-run under xvfb reads stdin again
       return cmd_render(input, ra);

@@ -99,6 +99,8 @@ class ExplicitSolver {
   const Binning& binning() const { return binning_; }
   KernelTimers& timers() { return timers_; }
   std::size_t removed_particles() const { return removed_count_; }
+  /// Particles split into 2^D children so far (graded grids, 004 section 3.3).
+  long splits() const { return split_count_; }
   const Scene& scene() const { return scene_; }
   ScatterStrategy strategy() const { return strategy_; }
   /// Bytes held by the solver beyond the particle columns: grid window, private scatter
@@ -139,6 +141,7 @@ class ExplicitSolver {
   template <bool Remap, bool Move>
   void g2p();
   void update_stress(const std::vector<Vec<D>>& v_grad, bool move);
+  void split_particles();  // graded grids only: graded_split.hpp
 
   // Helpers.
   void apply_boundary(std::vector<Vec<D>>& vel, std::vector<Vec<D>>* acc, bool record_force);
@@ -177,6 +180,9 @@ class ExplicitSolver {
   std::vector<std::vector<std::uint32_t>> strays_;  ///< per thread
   std::vector<std::unique_ptr<StressScratch>> scratch_;  ///< per thread
   KernelTimers timers_;
+  std::uint32_t next_id_ = 0;  ///< id of the next particle a split creates (0: not yet known)
+  long split_count_ = 0;       ///< particles split so far
+  int split_wait_ = 0;         ///< steps the pending splits have waited for a sort
 };
 
 /// The uniform-grid solver of a scene: builds the window grid on the scene's lattice.

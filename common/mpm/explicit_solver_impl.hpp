@@ -42,6 +42,7 @@ void ExplicitSolver<GridT>::step(double dt) {
       update_stress(grid_.v_remap, true); // x_p (eqs. 7, 9); stress (eqs. 12-15)
       break;
   }
+  if constexpr (GridT::kGraded) split_particles();  // coarse particles in finer cells (004, 3.3)
   // USF computes its forces from the stress it just updated, MUSL and USL from last step's.
   const double internal_paired = scheme_ == Scheme::USF ? balance_.internal : internal_start;
   balance_.leapfrog_total =
@@ -830,8 +831,11 @@ void ExplicitSolver<GridT>::update_stress(const std::vector<Vec<D>>& v_grad, boo
             if (axi) v_r += N[c] * vg[0];
             if (move) vbar += N[c] * (home ? v_c[c] : v_i[nd[c]]);
           }
-          // A block is a contiguous run of one material: a skipped rigid particle ends it.
-          if (int(p.material[i]) != mat || k == kBlock || i != i0 + std::uint32_t(k)) {
+          if (p.strain) p.strain[i] += dt * L.diagonal();  // for splitting (004, eq. 23)
+          // A block is a contiguous run of one material and one cell size: a skipped rigid
+          // particle ends it.
+          if (int(p.material[i]) != mat || k == kBlock || i != i0 + std::uint32_t(k) ||
+              h_cell != h_block) {
             flush();
             mat = p.material[i];
             i0 = i;
@@ -849,7 +853,6 @@ void ExplicitSolver<GridT>::update_stress(const std::vector<Vec<D>>& v_grad, boo
             track_move(p.x[i], i, bin.key, s);
           }
         }
-        if (GridT::kFixedNodes == false) flush();  // cell sizes may differ between bins
       }
       flush();
     }

@@ -21,6 +21,7 @@ enum class Where : std::uint8_t { Window, OutsideWindow, OutsideDomain };
 // What the kernels need of a grid (UniformGrid here; a graded grid provides the same):
 //   static constexpr int kMaxNodes;     nodes of a cell, at most
 //   static constexpr bool kFixedNodes;  every cell has kMaxNodes nodes
+//   static constexpr bool kGraded;      levels: the step splits particles (graded_grid.hpp)
 //   void fit(const Vec<D>* x, size_t n);              window/levels for these particles
 //   Where where(x, key, xi);                          cell key and local coordinates of x
 //   void locate(x, key, xi);                          the same for x known to be in the window
@@ -38,6 +39,7 @@ class UniformGrid {
   static constexpr int kDim = D;
   static constexpr int kMaxNodes = kCorners<D>;
   static constexpr bool kFixedNodes = true;
+  static constexpr bool kGraded = false;  ///< no levels, no particle splitting
 
   UniformGrid(const Lattice& lattice, const BoundarySpec& boundary);
 

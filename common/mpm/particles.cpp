@@ -60,6 +60,12 @@ void prepare_columns(ColumnStore& cols, const Scene& scene) {
   const ColumnNeeds need = column_needs(scene);
   if (need.eps_p) ensure(cols, {col::eps_p, ScalarType::F64, 1, "-"});
   if (need.failed) ensure(cols, {col::failed, ScalarType::U8, 1, "-"});
+  if (!scene.grid.levels.empty()) {
+    // Graded grids: the strain that places split children (004, eq. 23) and each particle's
+    // level (0 = not yet known: the level it starts in, set by the first split pass).
+    ensure(cols, {col::strain, ScalarType::F64, d, "-"});
+    ensure(cols, {col::level, ScalarType::U8, 1, "-"});
+  }
   if (need.T && !cols.has(col::T)) {
     cols.add({col::T, ScalarType::F64, 1, "K"});
     double* T = cols.get<double>(col::T);
@@ -108,6 +114,7 @@ ParticleView<D> view(ColumnStore& cols) {
   p.T = cols.get<double>(col::T);
   p.failed = cols.get<std::uint8_t>(col::failed);
   p.f_ext = cols.get<Vec<D>>(col::f_ext);
+  p.strain = cols.get<Vec<D>>(col::strain);
   p.id = cols.get<std::uint32_t>(col::id);
   p.material = cols.get<std::uint8_t>(col::material);
   p.body = cols.get<std::uint8_t>(col::body);

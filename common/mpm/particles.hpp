@@ -27,6 +27,8 @@ inline const std::string eps_p = "eps_p";        ///< f64, equivalent plastic st
 inline const std::string T = "T";                ///< f64, temperature, K
 inline const std::string failed = "failed";      ///< u8, 1 once the failure criterion was met
 inline const std::string f_ext = "f_ext";        ///< D x f64, applied force (loads), N
+inline const std::string strain = "strain";      ///< D x f64, accumulated normal strains (graded grids)
+inline const std::string level = "level";        ///< u8, grid level of the particle's spacing (graded grids)
 }  // namespace col
 
 /// Material id of the particles of rigid bodies (they have no material).
@@ -47,6 +49,7 @@ struct ParticleView {
   double* T = nullptr;
   std::uint8_t* failed = nullptr;
   Vec<D>* f_ext = nullptr;
+  Vec<D>* strain = nullptr;  ///< integral of the rate of deformation's diagonal (graded grids)
   std::uint32_t* id = nullptr;
   std::uint8_t* material = nullptr;
   std::uint8_t* body = nullptr;

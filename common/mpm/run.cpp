@@ -11,6 +11,7 @@
 
 #include "mpm/error.hpp"
 #include "mpm/explicit_solver.hpp"
+#include "mpm/graded_solver.hpp"
 #include "mpm/implicit/implicit_solver.hpp"
 #include "mpm/lattice.hpp"
 #include "mpm/stream.hpp"
@@ -171,10 +172,21 @@ template <class Solver>
 int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Solver& solver) {
   constexpr int D = Solver::D;
   constexpr bool implicit = HasImplicitWork<Solver>;
+  using GridT = std::remove_cvref_t<decltype(solver.grid())>;
   const int threads = omp_get_max_threads();
   StreamWriter out(opt.output);
   out.write_text(RecordType::Scene, scene.toml);
   out.write_text(RecordType::Info, run_info(scene, lattice, threads));
+  // Graded grids: a GRID record at the start and whenever the grid was rebuilt.
+  long grid_revision = -1;
+  auto emit_grid = [&]() {
+    if constexpr (GridT::kGraded) {
+      if (solver.grid().revision() == grid_revision) return;
+      grid_revision = solver.grid().revision();
+      out.write_record(RecordType::Grid, encode_grid(solver.grid().mesh(solver.steps(), solver.time())));
+    }
+  };
+  emit_grid();
 
   const OutputSpec& o = scene.output;
   const double end = scene.solver.end_time;
@@ -185,6 +197,7 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
   auto emit_frame = [&](std::uint32_t flags) {
     ScopedTimer timer(timers, t_output);
     history.flush(out);
+    emit_grid();
     Frame f;
     f.step = solver.steps();
     f.time = solver.time();
@@ -290,6 +303,10 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
                  "%.4g, %.3f million particle-steps/s\n",
                  strategy.c_str(), threads, solver.particles().size(), solver.steps(),
                  solver.binning().sorts(), ps, wall > 0 ? ps / wall / 1e6 : 0.0);
+    if constexpr (GridT::kGraded)
+      std::fprintf(stderr, "graded grid: %d levels, %zu cells, %zu nodes; %ld particles split\n",
+                   solver.grid().levels(), solver.grid().key_count(), solver.grid().nodes(),
+                   solver.splits());
     const double peak = peak_memory();
     std::fprintf(stderr,
                  "peak memory %.1f MB, %.0f bytes per particle (all of the process: particles, "
@@ -317,7 +334,11 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
 
 template <int D>
 int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame& model) {
+  const bool graded = !scene.grid.levels.empty();  // mesh grading (004, section 3)
   if (scene.solver.type == SolverType::Implicit) {
+    if (graded)
+      throw InputError("grid.levels", "the implicit solver runs on a uniform grid; remove the "
+                                      "[[grid.levels]] boxes or use solver.type = \"explicit\"");
     ImplicitSolver<UniformGrid<D>> solver(scene, UniformGrid<D>(lattice, scene.boundary),
                                           model.columns);
     return run_solver(opt, scene, lattice, solver);
@@ -327,6 +348,14 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
     throw InputError("--deterministic",
                      "only the colored strategy gives results independent of the thread count "
                      "(it is the default); drop --strategy " + opt.strategy);
+  if (graded) {
+    if (strategy == ScatterStrategy::Patch)
+      throw InputError("--strategy", "the patch strategy needs a uniform grid; this scene has "
+                                     "[[grid.levels]] (use colored, lr-slabs or array-expansion)");
+    ExplicitSolver<GradedGrid<D>> solver(scene, GradedGrid<D>(lattice, scene), model.columns,
+                                         strategy);
+    return run_solver(opt, scene, lattice, solver);
+  }
   UniformSolver<D> solver(scene, UniformGrid<D>(lattice, scene.boundary), model.columns, strategy);
   return run_solver(opt, scene, lattice, solver);
 }

@@ -791,6 +791,72 @@ void read_loads(Reader& top, Scene& s) {
 // ---------------------------------------------------------------------------------------------
 // Grid, boundary, solver, output
 
+/// [[grid.levels]]: the refined boxes of a graded grid (004, section 3.1). Alignment to the
+/// coarser lattice and the domain are checked here; nesting and the one-level rule between
+/// neighbouring cells when the grid is built (graded_grid.cpp), naming the same keys.
+void read_levels(Reader& grid, Scene& s) {
+  const toml::node* node = grid.get("levels");
+  if (!node) return;
+  const int n = s.dimension;
+  const GridSpec& g = s.grid;
+  const auto* arr = node->as_array();
+  if (!arr)
+    grid.fail("levels", "expected an array of tables ([[grid.levels]], note the double brackets), " +
+                            got(*node));
+  if (!g.domain_given)
+    grid.fail("levels", "level boxes need grid.domain: they are aligned to the lattice that starts "
+                        "at domain.min");
+  const Doc& doc = grid.doc();
+  const Origin array_origin = grid.origin_of(*node);
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    const toml::node& e = (*arr)[i];
+    const std::string path = "grid.levels." + std::to_string(i);
+    const Origin o = doc.origin(e, array_origin);
+    const auto* t = e.as_table();
+    if (!t) throw InputError(doc.where(o, path), "expected a table ([[grid.levels]]), " + got(e));
+    Reader r(doc, *t, path, o, {"level", "min", "max", "follow"});
+    LevelSpec l;
+    l.loc = r.loc();
+    const auto level = r.integer("level", 2, 12);
+    if (!level) r.missing("level", "2 for cells of half the grid.cell_size, 3 for a quarter, ...");
+    l.level = int(*level);
+    const std::string ex = n == 3 ? "\"-4 -4 0 mm\"" : "\"-4 0 mm\"";
+    const auto lo = r.vector("min", dim::length, n);
+    if (!lo) r.missing("min", "the box's lower corner, e.g. " + ex);
+    const auto hi = r.vector("max", dim::length, n);
+    if (!hi) r.missing("max", "the box's upper corner");
+    l.min = *lo;
+    l.max = *hi;
+    const double hp = std::ldexp(g.cell_size, -(l.level - 2));  // the coarser level's cells
+    for (int a = 0; a < n; ++a) {
+      const std::string axis(1, "xyz"[a]);
+      r.check("max", l.max[a] > l.min[a], "must exceed min in every component");
+      for (const char* key : {"min", "max"}) {
+        const double v = std::string_view(key) == "min" ? l.min[a] : l.max[a];
+        if (v < g.domain_min[a] - 1e-9 * hp || v > g.domain_max[a] + 1e-9 * hp)
+          r.fail(key, "the box leaves grid.domain along " + axis);
+        const double cells = (v - g.domain_min[a]) / hp;
+        if (std::abs(cells - std::round(cells)) > 1e-6)
+          r.fail(key, "a level-" + std::to_string(l.level) + " box must lie on the level-" +
+                          std::to_string(l.level - 1) + " lattice: " + axis + " = " +
+                          format_number(v * 1e3) + " mm is not a multiple of " +
+                          format_number(hp * 1e3) + " mm from grid.domain.min (nearest: " +
+                          format_number((g.domain_min[a] + hp * std::round(cells)) * 1e3) + " mm)");
+      }
+    }
+    if (const auto body = r.string("follow")) {
+      l.follow = s.body_index(*body);
+      if (l.follow < 0) {
+        std::vector<std::string_view> known;
+        for (const auto& b : s.bodies) known.push_back(b.name);
+        r.fail("follow", "unknown body '" + *body + "' (known: " + join(known) + ")");
+      }
+    }
+    r.finish();
+    s.grid.levels.push_back(l);
+  }
+}
+
 void read_grid(Reader& r, Scene& s) {
   const int n = s.dimension;
   GridSpec& g = s.grid;
@@ -823,6 +889,7 @@ void read_grid(Reader& r, Scene& s) {
   } else {
     g.padding = r.quantity("padding", dim::length, Bound::NonNegative).value_or(2 * g.cell_size);
   }
+  read_levels(r, s);
   r.finish();
 }
 
@@ -1008,7 +1075,8 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
 
   {
     Reader g =
-        top.required_table("grid", {"cell_size", "domain", "padding"}, "cell_size is required");
+        top.required_table("grid", {"cell_size", "domain", "padding", "levels"},
+                           "cell_size is required");
     read_grid(g, s);
   }
   if (auto b =
@@ -1124,6 +1192,20 @@ void apply_override(toml::table& root, const std::string& arg, Doc& doc) {
     if (!t) throw InputError(loc, what + "." + sel + " is not a table");
     i = 2;
     walked = what + "." + sel;
+  } else if (parts.size() > 3 && parts[0] == "grid" && parts[1] == "levels") {
+    // grid.levels.<index>.<key>
+    auto* arr = root["grid"]["levels"].as_array();
+    if (!arr) throw InputError(loc, "the scene has no [[grid.levels]] to change");
+    const std::string& sel = parts[2];
+    std::size_t index = 0;
+    const auto [ptr, ec] = std::from_chars(sel.data(), sel.data() + sel.size(), index);
+    if (ec != std::errc() || ptr != sel.data() + sel.size() || index >= arr->size())
+      throw InputError(loc, "no level box with index " + sel + " (the scene has " +
+                                std::to_string(arr->size()) + ", numbered from 0)");
+    t = arr->get(index)->as_table();
+    if (!t) throw InputError(loc, "grid.levels." + sel + " is not a table");
+    i = 3;
+    walked = "grid.levels." + sel;
   }
   for (; i + 1 < parts.size(); ++i) {
     walked += (walked.empty() ? "" : ".") + parts[i];

@@ -105,13 +105,30 @@ struct LoadSpec {
   SourceLoc loc;
 };
 
+/// A refined box of a graded grid (004, section 3.1): its cells are cell_size / 2^(level - 1)
+/// across. Boxes are aligned to the lattice of the next coarser level and nested.
+struct LevelSpec {
+  int level = 2;              ///< 2, 3, ...; level 1 is the whole domain
+  Vec3 min = Vec3::Zero();    ///< lower corner, m
+  Vec3 max = Vec3::Zero();    ///< upper corner, m
+  int follow = -1;            ///< index into Scene::bodies: the box moves with its mass centre; -1: fixed
+  SourceLoc loc;              ///< key "grid.levels.<index>"
+};
+
 struct GridSpec {
   double cell_size = 0;        ///< h, m
   bool domain_given = false;   ///< else fitted to the bodies with padding
   Vec3 domain_min = Vec3::Zero();
   Vec3 domain_max = Vec3::Zero();
   double padding = 0;          ///< m, added around the bodies when the domain is fitted
+  std::vector<LevelSpec> levels;  ///< refined boxes of a graded grid; empty: a uniform grid
   SourceLoc loc;
+  /// Number of levels: 1 + the highest refinement (1 for a uniform grid).
+  int level_count() const {
+    int n = 1;
+    for (const auto& l : levels) n = l.level > n ? l.level : n;
+    return n;
+  }
 };
 
 enum class BoundaryType { Free, Slip, Fixed };

@@ -107,6 +107,7 @@ bool known_type(std::uint32_t type) {
     case RecordType::Info:
     case RecordType::Frame:
     case RecordType::History:
+    case RecordType::Grid:
     case RecordType::End: return true;
   }
   return false;
@@ -244,6 +245,15 @@ void StreamWriter::write_text(RecordType type, const std::string& text) {
                                 " is not a text record");
   begin_record(type, text.size());
   put(text.data(), text.size());
+  end_record();
+}
+
+void StreamWriter::write_record(RecordType type, const std::vector<std::byte>& payload) {
+  if (type != RecordType::Grid)
+    throw std::invalid_argument("write_record: " + record_name(std::uint32_t(type)) +
+                                " has its own writer");
+  begin_record(type, payload.size());
+  put(payload.data(), payload.size());
   end_record();
 }
 
@@ -615,6 +625,7 @@ StreamSummary read_stream(const std::string& path, const StreamVisitor& visitor)
     std::string text;
     HistoryBlock history;
     std::pair<int, std::string> end;
+    std::vector<std::byte> grid;
     // Only the reader's errors are damage; errors thrown by the visitor propagate.
     try {
       if (!r.next(type)) break;
@@ -650,6 +661,12 @@ StreamSummary read_stream(const std::string& path, const StreamVisitor& visitor)
         case RecordType::End:
           decode([&](auto& p) { end = StreamReader::decode_end(p); });
           break;
+        case RecordType::Grid:
+          if (visitor.grid)
+            grid = r.read_payload();
+          else
+            r.skip();
+          break;
         default:
           r.skip();  // a record type of a later minor version
       }
@@ -671,6 +688,9 @@ StreamSummary read_stream(const std::string& path, const StreamVisitor& visitor)
         break;
       case RecordType::History:
         if (visitor.history) visitor.history(std::move(history));
+        break;
+      case RecordType::Grid:
+        if (visitor.grid) visitor.grid(std::move(grid));
         break;
       case RecordType::End:
         s.ended = true;

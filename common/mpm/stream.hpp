@@ -17,7 +17,7 @@
 namespace mpm {
 
 inline constexpr std::uint16_t kStreamVersionMajor = 1;  ///< readers refuse other majors
-inline constexpr std::uint16_t kStreamVersionMinor = 0;  ///< readers accept any minor
+inline constexpr std::uint16_t kStreamVersionMinor = 1;  ///< readers accept any minor (1: GRID)
 
 /// Record types (little-endian fourcc).
 enum class RecordType : std::uint32_t {
@@ -26,6 +26,7 @@ enum class RecordType : std::uint32_t {
   Frame = 0x4D415246,    ///< "FRAM": particle columns at one time
   History = 0x54534948,  ///< "HIST": rows of scalar time histories
   End = 0x53444E45,      ///< "ENDS": status and message; absent when the writer was killed
+  Grid = 0x44495247,     ///< "GRID": a graded grid's nodes and cells (since 1.1; graded_grid.hpp)
 };
 /// "SCEN", "FRAM", ... for messages; "?xyz" style hex for unknown codes.
 std::string record_name(std::uint32_t type);
@@ -69,6 +70,8 @@ class StreamWriter {
   /// Float32 precision stores f64 columns as f32, except "x" (positions keep f64).
   void write_frame(const Frame& frame, const std::vector<std::string>& fields = {},
                    Precision precision = Precision::Float64);
+  /// Writes a record of binary payload (GRID: encode_grid in graded_grid.hpp).
+  void write_record(RecordType type, const std::vector<std::byte>& payload);
   /// Writes a HIST record (names and units must have the same size, values a multiple of it).
   void write_history(const HistoryBlock& block);
   /// Writes the ENDS record: status 0 for a completed run, non-zero with a message otherwise.
@@ -173,6 +176,8 @@ struct StreamVisitor {
   std::function<void(Frame&&)> frame;
   std::function<void(HistoryBlock&&)> history;
   std::function<void(int, const std::string&)> end;
+  /// GRID payloads (decode_grid in graded_grid.hpp); skipped when empty.
+  std::function<void(std::vector<std::byte>&&)> grid;
   bool want_frames = true;  ///< false: frames are skipped without decoding
 };
 

@@ -312,7 +312,8 @@ double density_of(const Scene& scene, const BodySpec& body) {
 
 }  // namespace
 
-ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyReport>& report) {
+ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyReport>& report,
+                     const VoxeliseCells& cells) {
   report.clear();
   const int dim = lat.dim;
   const double h = lat.h;
@@ -392,6 +393,7 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
                             "a particle spacing (h/n = " +
                             num(s) + " m)");
     };
+    if (empty && cells.allow_empty) continue;  // nothing of this body in these cells
     if (empty) throw no_particles(0);
 
     const long long ncx = P.c1[0] - P.c0[0];
@@ -436,6 +438,7 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
       std::uint64_t kept = 0, skipped = 0;
       // known = 1: the cell is wholly inside the region (only earlier bodies are tested).
       const auto test_cell = [&](long long ix, int known) {
+        if (cells.keep && !cells.keep({P.c0[0] + ix, P.c0[1] + iy, P.c0[2] + iz})) return;
         std::uint64_t idx = std::uint64_t(ix) * P.ppc;
         for (int pz = 0; pz < nz; ++pz) {
           const double z = P.zs[std::size_t(iz * nz + pz)];
@@ -494,7 +497,7 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
       P.skipped += row_skipped[std::size_t(r)];
     }
     P.kept = P.row_start.back();
-    if (P.kept == 0) throw no_particles(P.skipped);
+    if (P.kept == 0 && !cells.allow_empty) throw no_particles(P.skipped);
     total += P.kept;
     if (total > std::numeric_limits<std::uint32_t>::max())
       throw InputError(body_where(scene, body, ""),

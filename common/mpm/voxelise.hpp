@@ -3,6 +3,8 @@
 /// at cell-aligned positions (cell corner + (i + 1/2) h / n) that lie inside the body.
 /// Primitives use exact inside tests; meshes (STL, OFF, OBJ) use CGAL's Side_of_triangle_mesh
 /// on an AABB tree and must be closed.
+#include <array>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -41,10 +43,19 @@ struct BodyReport {
   std::size_t skipped_overlap = 0;  ///< points inside an earlier body, not created again
 };
 
+/// Which cells of the lattice voxelise fills: one level of a graded grid (graded_voxelise.hpp).
+struct VoxeliseCells {
+  /// Keeps a cell (global index along x, y, z; z = 0 in 2D); empty: every cell.
+  std::function<bool(const std::array<long long, 3>&)> keep;
+  bool allow_empty = false;  ///< a body may get no particle in these cells
+};
+
 /// Particles of all bodies, in body order. Columns: id (u32), body (u8), material (u8),
 /// x (dim x f64, m), v (dim x f64, m/s), m (f64, kg), rho (f64, kg/m^3).
 /// A point inside an earlier body is not created again (the earlier body owns it).
 /// Throws InputError when a body gets no particle (naming the body and its scene line).
-ColumnStore voxelise(const Scene& scene, const Lattice& lattice, std::vector<BodyReport>& report);
+/// With `cells`, only the cells it keeps are filled (and, with allow_empty, a body may get none).
+ColumnStore voxelise(const Scene& scene, const Lattice& lattice, std::vector<BodyReport>& report,
+                     const VoxeliseCells& cells = {});
 
 }  // namespace mpm

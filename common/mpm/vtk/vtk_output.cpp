@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -20,6 +21,7 @@
 
 #include <vtkActor.h>
 #include <vtkCamera.h>
+#include <vtkCellData.h>
 #include <vtkCellArray.h>
 #include <vtkCommand.h>
 #include <vtkDoubleArray.h>
@@ -52,6 +54,7 @@
 #include <vtkXMLUnstructuredGridWriter.h>
 
 #include "mpm/error.hpp"
+#include "mpm/graded_grid.hpp"
 #include "mpm/types.hpp"
 
 namespace mpm {
@@ -692,6 +695,69 @@ void write_vtu(const Frame& frame, int dim, const std::string& path) {
   writer->SetCompressorTypeToZLib();
   writer->SetCompressionLevel(1);   // fastest zlib: 4x smaller here, level 5 takes 3x as long
   writer->SetHeaderTypeToUInt64();  // blocks and arrays beyond 4 GiB
+  writer->SetIdTypeToInt64();
+  const int ok = writer->Write();
+  if (!ok || writer->GetErrorCode() != 0 || !errors->message.empty() || !pipeline_errors->message.empty())
+    throw IoError("cannot write " + path + ": " +
+                  writer_failure(*errors, writer->GetErrorCode(), *pipeline_errors, target.write_path(), path));
+  target.commit();
+}
+
+void write_grid_vtu(const GridMesh& mesh, const std::string& path) {
+  const std::size_t nn = mesh.nodes(), nc = mesh.cells();
+  const int corners = 1 << mesh.dim;
+  vtkNew<vtkUnstructuredGrid> grid;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(vtkIdType(nn));
+  for (std::size_t n = 0; n < nn; ++n)
+    points->SetPoint(vtkIdType(n), mesh.x[3 * n], mesh.x[3 * n + 1], mesh.x[3 * n + 2]);
+  grid->SetPoints(points);
+  // VTK's corner order from the grid's bit order (bit a set: upper along axis a).
+  static constexpr int kHex[8] = {0, 1, 3, 2, 4, 5, 7, 6};
+  vtkNew<vtkCellArray> cells;
+  cells->AllocateExact(vtkIdType(nc), vtkIdType(nc * corners));
+  std::vector<vtkIdType> ids(corners);
+  for (std::size_t c = 0; c < nc; ++c) {
+    for (int k = 0; k < corners; ++k) ids[k] = vtkIdType(mesh.corners[c * corners + kHex[k]]);
+    cells->InsertNextCell(corners, ids.data());
+  }
+  grid->SetCells(mesh.dim == 3 ? VTK_HEXAHEDRON : VTK_QUAD, cells);
+  vtkNew<vtkUnsignedCharArray> level, optional;
+  level->SetName("level");
+  optional->SetName("optional_nodes");
+  level->SetNumberOfValues(vtkIdType(nc));
+  optional->SetNumberOfValues(vtkIdType(nc));
+  for (std::size_t c = 0; c < nc; ++c) {
+    level->SetValue(vtkIdType(c), mesh.level[c]);
+    optional->SetValue(vtkIdType(c), static_cast<unsigned char>(std::popcount(mesh.mask[c])));
+  }
+  grid->GetCellData()->AddArray(level);
+  grid->GetCellData()->AddArray(optional);
+  grid->GetCellData()->SetActiveScalars("level");
+  vtkNew<vtkUnsignedCharArray> hanging;
+  hanging->SetName("hanging");
+  hanging->SetNumberOfValues(vtkIdType(nn));
+  hanging->FillValue(0);
+  for (auto n : mesh.optional) hanging->SetValue(vtkIdType(n), 1);
+  grid->GetPointData()->AddArray(hanging);
+  vtkFieldData* fd = grid->GetFieldData();
+  add_field_value<vtkDoubleArray>(fd, "TIME", mesh.time);
+  add_field_value<vtkDoubleArray>(fd, "TimeValue", mesh.time);
+  add_field_value<vtkTypeInt64Array>(fd, "CYCLE", vtkTypeInt64(mesh.step));
+
+  FileTarget target(path);
+  vtkNew<vtkXMLUnstructuredGridWriter> writer;
+  vtkNew<ErrorCatcher> errors, pipeline_errors;
+  writer->AddObserver(vtkCommand::ErrorEvent, errors);
+  writer->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, pipeline_errors);
+  writer->SetInputData(grid);
+  writer->SetFileName(target.write_path().c_str());
+  writer->SetDataModeToAppended();
+  writer->EncodeAppendedDataOff();
+  writer->SetCompressorTypeToZLib();
+  writer->SetCompressionLevel(1);
+  writer->SetHeaderTypeToUInt64();
   writer->SetIdTypeToInt64();
   const int ok = writer->Write();
   if (!ok || writer->GetErrorCode() != 0 || !errors->message.empty() || !pipeline_errors->message.empty())

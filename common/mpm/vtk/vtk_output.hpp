@@ -8,6 +8,8 @@
 
 namespace mpm {
 
+struct GridMesh;  // graded_grid.hpp
+
 /// Writes a frame as a VTK XML unstructured grid (.vtu) of vertex cells, one per particle,
 /// with every column but "x" as point data of its own type (u8 -> vtkUnsignedCharArray,
 /// u32 -> vtkUnsignedIntArray, ...): 2-component columns padded to 3 in 2D, 6-component
@@ -18,6 +20,13 @@ namespace mpm {
 /// `dim` is 2 or 3 (2D positions get z = 0). The file is written under a temporary name and
 /// renamed. Throws IoError when the file cannot be written, InputError for a bad frame.
 void write_vtu(const Frame& frame, int dim, const std::string& path);
+
+/// Writes a graded grid (a GRID record) as a .vtu: its cells as hexahedra (quads in 2D) with
+/// the cell fields "level" (1 = coarsest) and "optional_nodes" (how many mid-edge and mid-face
+/// nodes a transition cell carries), the point field "hanging" (1 for a mid-edge or mid-face
+/// node of a coarser cell), and field data "TIME", "TimeValue", "CYCLE". Written like
+/// write_vtu (binary, zlib, under a temporary name). Throws IoError.
+void write_grid_vtu(const GridMesh& mesh, const std::string& path);
 
 /// Writes a ParaView collection (.pvd) listing (time in s, file name relative to the .pvd).
 /// Throws IoError when the file cannot be written.
