@@ -137,7 +137,11 @@ void ColumnStore::gather(const std::vector<std::uint32_t>& perm) {
     }
     if (m > c->size()) throw std::logic_error("gather: permutation longer than the columns");
     c->resize(m);  // shrinking keeps the storage
-    c->swap_storage(spare_, spare_bytes_);
+    // Swap only buffers of the same size: a narrower column that took the wide spare would
+    // keep it, and after a few sorts every column would hold the widest column's bytes (seen
+    // as 580 instead of 190 bytes a particle). Otherwise copy back, sequentially.
+    if (c->capacity_bytes() == spare_bytes_) c->swap_storage(spare_, spare_bytes_);
+    else if (m > 0) std::memcpy(c->data(), dst, m * eb);
   }
   n_ = m;
 }

@@ -39,6 +39,8 @@ class Column {
   /// Reserves capacity for n elements.
   void reserve(std::size_t n);
   std::byte* data() { return data_.get(); }
+  /// Bytes of storage held (capacity times the element size).
+  std::size_t capacity_bytes() const { return capacity_ * info_.element_bytes(); }
   /// Deleter of column buffers (64-byte aligned).
   struct Free {
     void operator()(std::byte* p) const { ::operator delete[](p, std::align_val_t(64)); }
@@ -98,8 +100,9 @@ class ColumnStore {
   void reserve(std::size_t n);
   /// Reorders every column so that new element i is old element perm[i] (a gather).
   /// perm may be shorter than size() (elements not listed are dropped). Gathers each column
-  /// into one spare buffer and swaps it in (widest columns first, so the spare always fits);
-  /// the spare is as large as the widest column and is kept for the next call.
+  /// into one spare buffer (widest columns first, so the spare always fits), which is swapped
+  /// in when it has the column's size and copied back otherwise; the spare is as large as the
+  /// widest column and is kept for the next call, and no column's storage ever grows.
   void gather(const std::vector<std::uint32_t>& perm);
   /// Bytes held by the columns (not counting scratch).
   std::size_t bytes() const;
