@@ -3,9 +3,10 @@
 scatter strategy at 1 and 2 threads: particle-steps per second, speed-up, parallel efficiency,
 peak memory, bytes per particle (the whole process: particles, grid window, scratch), the
 kernel time table; plus the machine's roofline (mpm-roofline) and where each particle kernel
-sits against it. Prints tables and writes bench/out/bench.json.
+sits against it. Prints tables and writes bench/out/bench.json (--json).
 
 Usage: bench.py --build BUILD [--models 1,2,3] [--strategies ...] [--threads 1,2] [--steps N]
+                [--repeat N] [--json NAME]
 """
 import argparse, json, os, re, subprocess, sys, time
 
@@ -73,6 +74,10 @@ def main():
     ap.add_argument("--strategies", default=",".join(STRATEGIES))
     ap.add_argument("--threads", default="1,2")
     ap.add_argument("--steps", type=int, default=0, help="steps per run (0: by model size)")
+    ap.add_argument("--json", default="bench.json", help="file name of the JSON in bench/out")
+    ap.add_argument("--repeat", type=int, default=1,
+                    help="runs of each case, interleaved across thread counts; the run of median "
+                         "throughput is reported, with the range (shared machines are noisy)")
     a = ap.parse_args()
     b = os.path.abspath(a.build)
     prep, runner, roof = (f"{b}/mpm-prep/mpm-prep", f"{b}/mpm-run/mpm-run", f"{b}/bench/mpm-roofline")
@@ -98,14 +103,23 @@ def main():
              "--set", f"grid.domain={{ min = \"{-half:.6g} {-half:.6g} 0 mm\", max = \"{half:.6g} {half:.6g} {m['z'] * h:.6g} mm\" }}",
              "--set", f"solver.max_steps={steps}", "--set", "output.frames=1"])
         for st in a.strategies.split(","):
+            runs = {t: [] for t in threads}
+            for rep in range(a.repeat):  # 1, 2, 1, 2, ...: drifts of the machine hit both alike
+                for t in threads:
+                    t0 = time.time()
+                    r = run([runner, model, "-o", "/dev/null", "--threads", str(t), "--strategy", st,
+                             "--stats", "--progress", "none"])
+                    s = parse_stats(r.stderr)
+                    s.update(model=mk, seed_particles=m["seed_particles"], wall=time.time() - t0)
+                    runs[t].append(s)
             for t in threads:
-                t0 = time.time()
-                r = run([runner, model, "-o", "/dev/null", "--threads", str(t), "--strategy", st,
-                         "--stats", "--progress", "none"])
-                s = parse_stats(r.stderr)
-                s.update(model=mk, seed_particles=m["seed_particles"], wall=time.time() - t0)
+                ordered = sorted(runs[t], key=lambda r: r["mps"])
+                s = ordered[(len(ordered) - 1) // 2]  # the median (lower one of an even count)
+                s.update(repeats=len(ordered), mps_min=ordered[0]["mps"], mps_max=ordered[-1]["mps"])
                 results.append(s)
-                print(f"  model {mk} {st:16s} {t} thread(s): {s['mps']:7.3f} M particle-steps/s, "
+                spread = (f" (of {len(ordered)}: {ordered[0]['mps']:.3f}-{ordered[-1]['mps']:.3f})"
+                          if len(ordered) > 1 else "")
+                print(f"  model {mk} {st:16s} {t} thread(s): {s['mps']:7.3f} M particle-steps/s{spread}, "
                       f"{s['bytes_per_particle']} B/particle", flush=True)
 
     # Speed-up and efficiency against the same model and strategy at 1 thread.
@@ -115,11 +129,12 @@ def main():
             s["speedup"] = s["mps"] / one[0]["mps"]
             s["efficiency"] = s["speedup"] / s["threads"]
     print()
-    print("| model | particles (seed) | strategy | threads | steps | M particle-steps/s | speed-up | efficiency | peak MB | B/particle |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| model | particles (seed) | strategy | threads | steps | M particle-steps/s (median) | range | speed-up | efficiency | peak MB | B/particle |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for s in results:
         print(f"| {s['model']} | {s['particles']} ({s['seed_particles']}) | {s['strategy']} | {s['threads']} | {s['steps']} | "
-              f"{s['mps']:.3f} | {s.get('speedup', float('nan')):.3f} | {s.get('efficiency', float('nan')):.3f} | "
+              f"{s['mps']:.3f} | {s['mps_min']:.2f}-{s['mps_max']:.2f} ({s['repeats']}) | "
+              f"{s.get('speedup', float('nan')):.3f} | {s.get('efficiency', float('nan')):.3f} | "
               f"{s['peak_MB']:.1f} | {s['bytes_per_particle']} |")
 
     # Roofline position of the particle kernels (default strategy, largest model measured).
@@ -142,9 +157,9 @@ def main():
             s.setdefault("roofline", {})[k] = {"GFLOPs": gf, "GBs": gb, "intensity": ai, "bound": bound}
             print(f"| {s['model']} | {t} | {k} | {ns:.1f} | {ai:.2f} | {gf:.2f} | {gb:.2f} | {bound:.1f} | {100 * gf / bound:.1f}% |")
 
-    with open(os.path.join(out_dir, "bench.json"), "w") as f:
+    with open(os.path.join(out_dir, a.json), "w") as f:
         json.dump({"roofline": roofline, "kernel_work": KERNELS, "runs": results}, f, indent=1)
-    print(f"\nJSON: {os.path.join(out_dir, 'bench.json')}")
+    print(f"\nJSON: {os.path.join(out_dir, a.json)}")
     for s in results:
         if s["strategy"] == "colored":
             print(f"\nkernel times, model {s['model']}, {s['threads']} thread(s), colored:")

@@ -3,6 +3,7 @@
 /// 004, sections 2 and 3.4), in 3D, 2D plane strain and 2D axisymmetry, on any grid type
 /// that provides the interface described in grid.hpp (a uniform window here).
 /// The time step, ExplicitSolver::step, is at the top of explicit_solver_impl.hpp.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -37,6 +38,26 @@ struct Balance {
   /// swing: the energy guard watches this one.
   double leapfrog_total = 0;
 };
+
+/// Particles that left the domain (indices in `exits`, possibly repeated) take their energy
+/// with them: it moves from kinetic and internal to `removed`. Sorts and de-duplicates
+/// `exits` (the sort then drops them) and returns how many there are. Rigid particles carry
+/// no energy of the balance.
+template <int D>
+std::size_t account_exits(ColumnStore& particles, std::vector<std::uint32_t>& exits, Balance& balance) {
+  if (exits.empty()) return 0;
+  const ParticleView<D> p = view<D>(particles);
+  std::sort(exits.begin(), exits.end());
+  exits.erase(std::unique(exits.begin(), exits.end()), exits.end());
+  for (auto i : exits) {
+    if (p.material[i] == kRigidMaterial) continue;
+    const double ke = 0.5 * p.m[i] * p.v[i].squaredNorm(), ie = p.m[i] * p.e[i];
+    balance.removed += ke + ie;
+    balance.kinetic -= ke;
+    balance.internal -= ie;
+  }
+  return exits.size();
+}
 
 /// How the particle-to-grid scatters avoid write races without locks or atomics.
 enum class ScatterStrategy {
@@ -144,6 +165,19 @@ class ExplicitSolver {
   void split_particles();  // graded grids only: graded_split.hpp
 
   // Helpers.
+  /// Cell and local coordinates of a particle of the bin of cell `bin_key`: a graded grid
+  /// first tries that cell (GradedGrid::in_cell, the same result as locate without the tree
+  /// search); a uniform grid's locate is as cheap as that test.
+  [[gnu::always_inline]] void locate_in_bin(std::int64_t bin_key, const Vec<D>& x,
+                                            std::int64_t& key, Vec<D>& xi) const {
+    if constexpr (requires { grid_.in_cell(x, bin_key, xi); }) {
+      if (grid_.in_cell(x, bin_key, xi)) {
+        key = bin_key;
+        return;
+      }
+    }
+    grid_.locate(x, key, xi);
+  }
   void apply_boundary(std::vector<Vec<D>>& vel, std::vector<Vec<D>>* acc, bool record_force);
   void track_move(const Vec<D>& x, std::uint32_t i, std::int64_t bin_key, ChunkStats& s) const;
   void finish(std::vector<ChunkStats>& stats, bool moved, bool stressed, bool velocity);

@@ -151,20 +151,7 @@ std::size_t ExplicitSolver<GridT>::work_bytes() const {
 template <class GridT>
 void ExplicitSolver<GridT>::sort_particles() {
   ScopedTimer timer(timers_, timers_.id("sort"));
-  if (!exits_.empty()) {
-    // Particles that left the domain take their energy with them (balance_.removed).
-    const ParticleView<D> p = view<D>(particles_);
-    std::sort(exits_.begin(), exits_.end());
-    exits_.erase(std::unique(exits_.begin(), exits_.end()), exits_.end());
-    for (auto i : exits_) {
-      if (p.material[i] == kRigidMaterial) continue;
-      const double ke = 0.5 * p.m[i] * p.v[i].squaredNorm(), ie = p.m[i] * p.e[i];
-      balance_.removed += ke + ie;
-      balance_.kinetic -= ke;
-      balance_.internal -= ie;
-    }
-    removed_count_ += exits_.size();
-  }
+  removed_count_ += account_exits<D>(particles_, exits_, balance_);
   binning_.sort(particles_, grid_, exits_);
   exits_.clear();
   need_sort_ = false;
@@ -503,7 +490,7 @@ void ExplicitSolver<GridT>::p2g() {
       if (rigid(i)) continue;
       std::int64_t key;
       Vec<D> xi;
-      grid_.locate(p.x[i], key, xi);
+      locate_in_bin(bin.key, p.x[i], key, xi);
       if (key == bin.key) {
         contribute(i, key, xi, nn, to_cell);
       } else if (!strays || grid_.layer(key) == layer) {
@@ -701,7 +688,7 @@ void ExplicitSolver<GridT>::g2p() {
       }
       std::int64_t key;
       Vec<D> xi;
-      grid_.locate(p.x[i], key, xi);
+      locate_in_bin(bin.key, p.x[i], key, xi);
       const bool home = key == bin.key;
       const int nk = home ? nn : grid_.cell_nodes(key, other);
       const std::int64_t* nd = home ? nodes : other;
@@ -814,7 +801,7 @@ void ExplicitSolver<GridT>::update_stress(const std::vector<Vec<D>>& v_grad, boo
           }
           std::int64_t key;
           Vec<D> xi;
-          grid_.locate(p.x[i], key, xi);
+          locate_in_bin(bin.key, p.x[i], key, xi);
           const bool home = key == bin.key;
           const int nk = home ? nn : grid_.cell_nodes(key, other);
           const std::int64_t* nd = home ? nodes : other;

@@ -65,6 +65,7 @@ GradedGrid<D>::GradedGrid(const Lattice& lattice, const Scene& scene)
     lv.h = std::ldexp(h1_, -(l - 1));
     lv.inv_h = inv_h1_ * lv.scale;
     inv_h_[l] = lv.inv_h;
+    scale_[l] = lv.scale;
   }
   wn_ = cells1_;  // the whole domain first: the boxes are checked on it
   h_fine_ = level_[levels_].h;
@@ -423,8 +424,11 @@ bool GradedGrid<D>::build(bool validate) {
     }
 
   info_.resize(cells_.size());
-  for (std::size_t key = 0; key < cells_.size(); ++key)
+  cell_lo_.resize(cells_.size());
+  for (std::size_t key = 0; key < cells_.size(); ++key) {
     info_[key] = cells_[key].mask | (std::uint32_t(cells_[key].level) << kLevelShift);
+    cell_lo_[key] = cpos[key].template cast<double>();
+  }
 
   const std::size_t nn = node_ijk_.size();
   m.resize(nn);

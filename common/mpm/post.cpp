@@ -95,11 +95,14 @@ TaylorResult TaylorMeter::measure(const Frame& frame) const {
 
 namespace {
 
-/// p-th percentile (0..100) of values, by the nearest-rank rule on a sorted copy.
+/// p-th percentile (0..100) of values, by the nearest-rank rule on a sorted copy: the
+/// ceil(p n / 100)-th smallest. p n / 100 is rounded first (99.9 has no exact binary form, and
+/// 99.9 / 100 * 1000 would otherwise round up to the 1000th value).
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
-  const std::size_t k = std::min(v.size() - 1, std::size_t(std::ceil(p / 100.0 * double(v.size())) - 1));
+  const double rank = std::ceil(p / 100.0 * double(v.size()) * (1 - 1e-12));
+  const std::size_t k = std::min(v.size() - 1, std::size_t(std::max(rank, 1.0)) - 1);
   return v[p <= 0 ? 0 : k];
 }
 

@@ -201,6 +201,35 @@ void walk() {
   EXPECT_EQ(changes, 5);  // 1, 2, 3, 2, 1
 }
 
+// The kernels' bin fast path (in_cell) must agree bit for bit with locate: the same cell,
+// the same local coordinates, for random points and for points on cell faces of every level
+// (where rounding would show first), and it must refuse every other cell.
+template <int D>
+void in_cell_matches_locate() {
+  const GradedGrid<D> g = nested<D>();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 8e-3);
+  std::uniform_int_distribution<int> face(0, 32);
+  for (int t = 0; t < 200000; ++t) {
+    Vec<D> x;
+    for (int a = 0; a < D; ++a) {
+      x[a] = u(rng);
+      if (t % 2) x[a] = face(rng) * 0.25e-3;  // on faces of level-3 cells (0.25 mm)
+    }
+    std::int64_t key;
+    Vec<D> xi;
+    if (g.where(x, key, xi) != Where::Window) continue;
+    Vec<D> xi2;
+    ASSERT_TRUE(g.in_cell(x, key, xi2)) << "point " << x.transpose();
+    for (int a = 0; a < D; ++a) ASSERT_EQ(xi2[a], xi[a]);
+    const std::int64_t other = (key + 1 + t % 7) % std::int64_t(g.key_count());
+    if (other != key) ASSERT_FALSE(g.in_cell(x, other, xi2));
+  }
+}
+
+TEST(GradedGrid, BinFastPathAgreesWithLocateBitForBit3D) { in_cell_matches_locate<3>(); }
+TEST(GradedGrid, BinFastPathAgreesWithLocateBitForBit2D) { in_cell_matches_locate<2>(); }
+
 TEST(GradedGrid, WalkingPointKeepsWeightsSummingToOne3D) { walk<3>(); }
 TEST(GradedGrid, WalkingPointKeepsWeightsSummingToOne2D) { walk<2>(); }
 

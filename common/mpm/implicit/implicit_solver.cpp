@@ -245,19 +245,7 @@ void ImplicitSolver<GridT>::for_chunks_coloured(F&& body) {
 template <class GridT>
 void ImplicitSolver<GridT>::sort_particles() {
   ScopedTimer timer(timers_, timers_.id("sort"));
-  if (!exits_.empty()) {
-    const ParticleView<D> p = view<D>(particles_);
-    std::sort(exits_.begin(), exits_.end());
-    exits_.erase(std::unique(exits_.begin(), exits_.end()), exits_.end());
-    for (auto i : exits_) {
-      if (p.material[i] == kRigidMaterial) continue;
-      const double ke = 0.5 * p.m[i] * p.v[i].squaredNorm(), ie = p.m[i] * p.e[i];
-      balance_.removed += ke + ie;
-      balance_.kinetic -= ke;
-      balance_.internal -= ie;
-    }
-    removed_count_ += exits_.size();
-  }
+  removed_count_ += account_exits<D>(particles_, exits_, balance_);
   binning_.sort(particles_, grid_, exits_);
   exits_.clear();
   need_sort_ = false;

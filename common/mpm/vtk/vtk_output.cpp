@@ -596,6 +596,36 @@ constexpr const char* kSphereSplat =
 
 // ---------------------------------------------------------------------------------------------
 
+/// Time fields and the write of an unstructured grid as an appended, zlib-compressed .vtu,
+/// through a temporary file committed only when the write succeeded: "TIME" (VisIt convention,
+/// shown by ParaView's Annotate Time Filter), "TimeValue" (what VTK's and ParaView's XML readers
+/// use as the time of a lone file or file series), and the step as "CYCLE".
+static void write_unstructured(vtkUnstructuredGrid* grid, double time, std::int64_t step, const std::string& path) {
+  vtkFieldData* fd = grid->GetFieldData();
+  add_field_value<vtkDoubleArray>(fd, "TIME", time);
+  add_field_value<vtkDoubleArray>(fd, "TimeValue", time);
+  add_field_value<vtkTypeInt64Array>(fd, "CYCLE", vtkTypeInt64(step));
+
+  FileTarget target(path);
+  vtkNew<vtkXMLUnstructuredGridWriter> writer;
+  vtkNew<ErrorCatcher> errors, pipeline_errors;
+  writer->AddObserver(vtkCommand::ErrorEvent, errors);
+  writer->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, pipeline_errors);
+  writer->SetInputData(grid);
+  writer->SetFileName(target.write_path().c_str());
+  writer->SetDataModeToAppended();
+  writer->EncodeAppendedDataOff();  // raw binary, not base64
+  writer->SetCompressorTypeToZLib();
+  writer->SetCompressionLevel(1);   // fastest zlib: 4x smaller here, level 5 takes 3x as long
+  writer->SetHeaderTypeToUInt64();  // blocks and arrays beyond 4 GiB
+  writer->SetIdTypeToInt64();
+  const int ok = writer->Write();
+  if (!ok || writer->GetErrorCode() != 0 || !errors->message.empty() || !pipeline_errors->message.empty())
+    throw IoError("cannot write " + path + ": " +
+                  writer_failure(*errors, writer->GetErrorCode(), *pipeline_errors, target.write_path(), path));
+  target.commit();
+}
+
 void write_vtu(const Frame& frame, int dim, const std::string& path) {
   const Column& x = positions(frame, dim, "vtk");
   const std::size_t n = frame.columns.size();
@@ -675,32 +705,7 @@ void write_vtu(const Frame& frame, int dim, const std::string& path) {
     pd->AddArray(sp);
   }
 
-  // Time: "TIME" (VisIt convention, shown by ParaView's Annotate Time Filter), "TimeValue"
-  // (what VTK's and ParaView's XML readers use as the time of a lone file or file series),
-  // and the step as "CYCLE".
-  vtkFieldData* fd = grid->GetFieldData();
-  add_field_value<vtkDoubleArray>(fd, "TIME", frame.time);
-  add_field_value<vtkDoubleArray>(fd, "TimeValue", frame.time);
-  add_field_value<vtkTypeInt64Array>(fd, "CYCLE", vtkTypeInt64(frame.step));
-
-  FileTarget target(path);
-  vtkNew<vtkXMLUnstructuredGridWriter> writer;
-  vtkNew<ErrorCatcher> errors, pipeline_errors;
-  writer->AddObserver(vtkCommand::ErrorEvent, errors);
-  writer->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, pipeline_errors);
-  writer->SetInputData(grid);
-  writer->SetFileName(target.write_path().c_str());
-  writer->SetDataModeToAppended();
-  writer->EncodeAppendedDataOff();  // raw binary, not base64
-  writer->SetCompressorTypeToZLib();
-  writer->SetCompressionLevel(1);   // fastest zlib: 4x smaller here, level 5 takes 3x as long
-  writer->SetHeaderTypeToUInt64();  // blocks and arrays beyond 4 GiB
-  writer->SetIdTypeToInt64();
-  const int ok = writer->Write();
-  if (!ok || writer->GetErrorCode() != 0 || !errors->message.empty() || !pipeline_errors->message.empty())
-    throw IoError("cannot write " + path + ": " +
-                  writer_failure(*errors, writer->GetErrorCode(), *pipeline_errors, target.write_path(), path));
-  target.commit();
+  write_unstructured(grid, frame.time, frame.step, path);
 }
 
 void write_grid_vtu(const GridMesh& mesh, const std::string& path) {
@@ -741,29 +746,7 @@ void write_grid_vtu(const GridMesh& mesh, const std::string& path) {
   hanging->FillValue(0);
   for (auto n : mesh.optional) hanging->SetValue(vtkIdType(n), 1);
   grid->GetPointData()->AddArray(hanging);
-  vtkFieldData* fd = grid->GetFieldData();
-  add_field_value<vtkDoubleArray>(fd, "TIME", mesh.time);
-  add_field_value<vtkDoubleArray>(fd, "TimeValue", mesh.time);
-  add_field_value<vtkTypeInt64Array>(fd, "CYCLE", vtkTypeInt64(mesh.step));
-
-  FileTarget target(path);
-  vtkNew<vtkXMLUnstructuredGridWriter> writer;
-  vtkNew<ErrorCatcher> errors, pipeline_errors;
-  writer->AddObserver(vtkCommand::ErrorEvent, errors);
-  writer->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, pipeline_errors);
-  writer->SetInputData(grid);
-  writer->SetFileName(target.write_path().c_str());
-  writer->SetDataModeToAppended();
-  writer->EncodeAppendedDataOff();
-  writer->SetCompressorTypeToZLib();
-  writer->SetCompressionLevel(1);
-  writer->SetHeaderTypeToUInt64();
-  writer->SetIdTypeToInt64();
-  const int ok = writer->Write();
-  if (!ok || writer->GetErrorCode() != 0 || !errors->message.empty() || !pipeline_errors->message.empty())
-    throw IoError("cannot write " + path + ": " +
-                  writer_failure(*errors, writer->GetErrorCode(), *pipeline_errors, target.write_path(), path));
-  target.commit();
+  write_unstructured(grid, mesh.time, mesh.step, path);
 }
 
 void write_pvd(const std::vector<std::pair<double, std::string>>& entries, const std::string& path) {
