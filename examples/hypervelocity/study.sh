@@ -1,20 +1,16 @@
 #!/usr/bin/env bash
 # Runs V4 variants and appends a row per variant to out/table.md: particles, cells, steps,
 # wall time, throughput, peak memory, and the debris front and width at 30.6 us (99.5th
-# percentile of the cloud's particles, mpm-post debris; with the 99.9th and the maxima) against
-# the experiment (200 mm, 145 mm). Also a side-view PNG.
-# Usage: ./study.sh BUILD_DIR [--post] VARIANT...   (coarse, small-1.06, small-1.59, small-2.12,
-#        large); --post measures the existing out/VARIANT.mpm again without running it.
+# percentile, with the maxima) against the experiment (200 mm, 145 mm). Also a side-view PNG.
+# Usage: ./study.sh BUILD_DIR VARIANT...   (coarse, small-1.06, small-1.59, small-2.12, large)
 set -euo pipefail
 cd "$(dirname "$0")"
 bin=$1; shift
-post_only=0
-if [ "${1:-}" = "--post" ]; then post_only=1; shift; fi  # measure existing out/VARIANT.mpm again
 mkdir -p out
 table=out/table.md
 [ -f "$table" ] || {
-  echo "| variant | particles | cell mm | spacing mm | steps | wall s | Mpart-steps/s | peak MB | front p99.5 mm | width p99.5 mm | front vs exp | width vs exp | front p99.9 | width p99.9 | front max | width max |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "| variant | particles | cell mm | spacing mm | steps | wall s | Mpart-steps/s | peak MB | front p99.5 mm | width p99.5 mm | front max mm | width max mm | front vs exp | width vs exp |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 } > "$table"
 for variant in "$@"; do
   sets=()
@@ -35,21 +31,17 @@ for variant in "$@"; do
     *) echo "unknown variant $variant" >&2; exit 2 ;;
   esac
   out=out/$variant.mpm
-  if [ "$post_only" = 0 ]; then
-    start=$(date +%s.%N)
-    "$bin/mpm-prep/mpm-prep" scene.toml "${sets[@]}" --set output.frames=$frames 2> out/prep_$variant.log |
-      "$bin/mpm-run/mpm-run" --stats --progress lines -o "$out" 2> out/run_$variant.log
-    end=$(date +%s.%N)
-    echo "$start $end" > out/wall_$variant.txt
-  fi
+  start=$(date +%s.%N)
+  "$bin/mpm-prep/mpm-prep" scene.toml "${sets[@]}" --set output.frames=$frames 2> out/prep_$variant.log |
+    "$bin/mpm-run/mpm-run" --stats --progress lines -o "$out" 2> out/run_$variant.log
+  end=$(date +%s.%N)
   "$bin/mpm-post/mpm-post" debris "$out" --time "30.6 us" --expect-front "200 mm" --expect-width "145 mm" | tee out/debris_$variant.txt
   json=$("$bin/mpm-post/mpm-post" debris "$out" --time "30.6 us" --json)
   "$bin/mpm-post/mpm-post" render "$out" --time "30.6 us" -o "out/$variant.png" --field speed --view side \
     --title "V4 $variant: debris cloud at 30.6 us, coloured by speed (m/s)" --size 1600x900
-  python3 - "$variant" "$json" out/wall_$variant.txt out/run_$variant.log out/prep_$variant.log >> "$table" <<'PY'
+  python3 - "$variant" "$json" "$start" "$end" out/run_$variant.log out/prep_$variant.log >> "$table" <<'PY'
 import json, re, sys
-variant, d, wall, runlog, preplog = sys.argv[1], json.loads(sys.argv[2]), sys.argv[3], sys.argv[4], sys.argv[5]
-t0, t1 = map(float, open(wall).read().split())
+variant, d, t0, t1, runlog, preplog = sys.argv[1], json.loads(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4]), sys.argv[5], sys.argv[6]
 run, prep = open(runlog).read(), open(preplog).read()
 m = re.search(r"particles (\d+), steps (\d+), sorts \d+, particle-steps [0-9.e+]+, ([0-9.]+) million", run)
 peak = re.search(r"peak memory ([0-9.]+) MB", run).group(1)
@@ -57,10 +49,7 @@ cell = re.search(r"cell ([0-9.]+) mm", prep).group(1)
 spacing = re.search(r"plate\s+lead\s+\d+\s+([0-9.]+) mm", prep).group(1)
 total = re.search(r"total\s+(\d+)", prep).group(1)
 mm = lambda v: f"{1e3 * v:.1f}"
-pct = lambda v, e: f"{100 * (v / e - 1):+.1f}%"
-print(f"| {variant} | {total} | {cell} | {spacing} | {m.group(2)} | {t1 - t0:.0f} | {m.group(3)} | {peak} | "
-      f"{mm(d['front'])} | {mm(d['width'])} | {pct(d['front'], 0.2)} | {pct(d['width'], 0.145)} | "
-      f"{mm(d['front_p99_9'])} | {mm(d['width_p99_9'])} | {mm(d['front_max'])} | {mm(d['width_max'])} |")
+print(f"| {variant} | {total} | {cell} | {spacing} | {m.group(2)} | {t1 - t0:.0f} | {m.group(3)} | {peak} | {mm(d['front'])} | {mm(d['width'])} | {mm(d['front_max'])} | {mm(d['width_max'])} | {100 * (d['front'] / 0.2 - 1):+.1f}% | {100 * (d['width'] / 0.145 - 1):+.1f}% |")
 PY
 done
 cat "$table"
