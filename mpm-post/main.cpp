@@ -308,8 +308,9 @@ int cmd_taylor(const std::string& path, const TaylorArgs& a) {
 
 // debris ----------------------------------------------------------------------------------
 struct DebrisArgs {
-  std::string time, axis, plane, target, projectile, expect_front, expect_width;
+  std::string time, axis, plane, target, projectile, expect_front, expect_width, link;
   double percentile = 99.5;
+  std::size_t min_fragment = 1;
   bool json = false;
 };
 
@@ -318,6 +319,8 @@ int cmd_debris(const std::string& path, const DebrisArgs& a) {
   opt.target = a.target;
   opt.projectile = a.projectile;
   opt.percentile = a.percentile;
+  opt.min_fragment = a.min_fragment;
+  if (!a.link.empty()) opt.link = quantity(a.link, dim::length, "--link");
   if (!a.axis.empty()) opt.axis = axis_of(a.axis);
   if (!a.plane.empty()) opt.plane = quantity(a.plane, dim::length, "--plane");
   std::optional<double> at;
@@ -359,6 +362,9 @@ int cmd_debris(const std::string& path, const DebrisArgs& a) {
                 json_number(r.front_p995).c_str(), json_number(r.front_p999).c_str(),
                 json_number(r.width_max).c_str(), json_number(r.width_p99).c_str(),
                 json_number(r.width_p995).c_str(), json_number(r.width_p999).c_str());
+    std::printf(", \"link\": %s, \"min_fragment\": %zu, \"fragments\": %zu, \"single_particle_fragments\": %zu, "
+                "\"largest_fragment\": %zu, \"counted_particles\": %zu",
+                json_number(r.link).c_str(), r.min_fragment, r.fragments, r.singles, r.largest, r.counted);
     if (ef) std::printf(", \"expected_front\": %s, \"error_front\": %s", json_number(*ef).c_str(), json_number(r.front / *ef - 1).c_str());
     if (ew) std::printf(", \"expected_width\": %s, \"error_width\": %s", json_number(*ew).c_str(), json_number(r.width / *ew - 1).c_str());
     std::printf("}\n");
@@ -367,6 +373,10 @@ int cmd_debris(const std::string& path, const DebrisArgs& a) {
                 "(the target's rear face), impact along %s%c\n",
                 r.time * 1e6, r.cloud, r.total, "xyz"[r.axis], r.plane * 1e3, r.direction > 0 ? "+" : "-",
                 "xyz"[r.axis]);
+    std::printf("  fragments (particles closer than %.3g mm linked): %zu, %zu of them single particles, the "
+                "largest %zu particles\n", r.link * 1e3, r.fragments, r.singles, r.largest);
+    if (r.min_fragment > 1)
+      std::printf("  counted: the %zu particles of fragments of at least %zu particles\n", r.counted, r.min_fragment);
     std::printf("  %-8s %10s %10s %10s %10s\n", "mm", "max", "p99", "p99.5", "p99.9");
     std::printf("  %-8s %10.1f %10.1f %10.1f %10.1f\n", "front", r.front_max * 1e3, r.front_p99 * 1e3,
                 r.front_p995 * 1e3, r.front_p999 * 1e3);
@@ -721,6 +731,12 @@ int main(int argc, char** argv) {
                      "cloud's distances (stray particles beyond it are ignored; max and 99/99.5/99.9 are "
                      "always printed)")
       ->check(CLI::Range(0.0, 100.0))->capture_default_str();
+  debris->add_option("--min-fragment", da.min_fragment,
+                     "which particles count: only those of fragments of at least this many particles "
+                     "(particles closer than --link are one fragment); 1: all")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  debris->add_option("--link", da.link,
+                     "linking length of fragments, e.g. \"1 mm\" (default: the grid's cell size)");
   debris->add_option("--expect-front", da.expect_front, "reference front, e.g. \"200 mm\"");
   debris->add_option("--expect-width", da.expect_width, "reference width, e.g. \"145 mm\"");
   debris->add_flag("--json", da.json, "print JSON (SI units)");

@@ -108,6 +108,76 @@ double percentile(std::vector<double> v, double p) {
 
 }  // namespace
 
+std::vector<std::size_t> fragment_sizes(const std::vector<Vec3>& points, double link) {
+  const std::size_t n = points.size();
+  std::vector<std::size_t> size(n, 1);
+  if (n == 0) return size;
+  if (!(link > 0)) throw InputError("--link", "expected a positive linking length");
+  // Union-find over the points, by size, with path halving.
+  std::vector<std::size_t> parent(n);
+  for (std::size_t i = 0; i < n; ++i) parent[i] = i;
+  auto root = [&](std::size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  auto join = [&](std::size_t a, std::size_t b) {
+    a = root(a), b = root(b);
+    if (a == b) return;
+    if (size[a] < size[b]) std::swap(a, b);
+    parent[b] = a;
+    size[a] += size[b];
+  };
+  // Bin the points in cubes of side `link`: linked points lie in the same or adjacent cubes.
+  Vec3 lo = points[0];
+  for (const Vec3& p : points) lo = lo.cwiseMin(p);
+  constexpr std::int64_t kSide = 1 << 20;
+  auto cell = [&](const Vec3& p, int a) { return std::int64_t(std::floor((p[a] - lo[a]) / link)); };
+  auto key = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+    return std::uint64_t((i * kSide + j) * kSide + k);
+  };
+  std::vector<std::pair<std::uint64_t, std::size_t>> bins(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int64_t c[3] = {cell(points[i], 0), cell(points[i], 1), cell(points[i], 2)};
+    if (c[0] >= kSide || c[1] >= kSide || c[2] >= kSide)
+      throw InputError("--link", "the cloud spans more than 2^20 linking lengths: give a longer --link");
+    bins[i] = {key(c[0], c[1], c[2]), i};
+  }
+  std::sort(bins.begin(), bins.end());
+  const double link2 = link * link;
+  auto range = [&](std::uint64_t k) {
+    auto first = std::lower_bound(bins.begin(), bins.end(), std::make_pair(k, std::size_t(0)));
+    auto last = first;
+    while (last != bins.end() && last->first == k) ++last;
+    return std::make_pair(first, last);
+  };
+  // Each bin against itself and its 13 neighbours that come after it.
+  for (auto b = bins.begin(); b != bins.end();) {
+    const std::size_t i0 = b->second;
+    const std::int64_t c[3] = {cell(points[i0], 0), cell(points[i0], 1), cell(points[i0], 2)};
+    auto e = b;
+    while (e != bins.end() && e->first == b->first) ++e;
+    for (auto p = b; p != e; ++p)
+      for (auto q = p + 1; q != e; ++q)
+        if ((points[p->second] - points[q->second]).squaredNorm() < link2) join(p->second, q->second);
+    for (int di = -1; di <= 1; ++di)
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int dk = -1; dk <= 1; ++dk) {
+          const int order = di * 9 + dj * 3 + dk;
+          if (order <= 0) continue;  // half of the 26 neighbours: each pair of bins once
+          const std::int64_t ni = c[0] + di, nj = c[1] + dj, nk = c[2] + dk;
+          if (ni < 0 || nj < 0 || nk < 0) continue;
+          const auto [f, l] = range(key(ni, nj, nk));
+          for (auto p = b; p != e; ++p)
+            for (auto q = f; q != l; ++q)
+              if ((points[p->second] - points[q->second]).squaredNorm() < link2) join(p->second, q->second);
+        }
+    b = e;
+  }
+  std::vector<std::size_t> out(n);
+  for (std::size_t i = 0; i < n; ++i) out[i] = size[root(i)];
+  return out;
+}
+
 DebrisMeter::DebrisMeter(const Scene& scene, const Frame& first, const DebrisOptions& options)
     : opt_(options) {
   const Column* xc = first.columns.find(col::x);
@@ -161,6 +231,8 @@ DebrisMeter::DebrisMeter(const Scene& scene, const Frame& first, const DebrisOpt
   point_ /= double(np);
   const double spacing = scene.grid.cell_size / scene.bodies[target].particles_per_cell;
   plane_ = opt_.plane ? *opt_.plane : direction_ * (far + 0.5 * spacing);
+  link_ = opt_.link > 0 ? opt_.link : scene.grid.cell_size;
+  if (opt_.min_fragment < 1) throw InputError("--min-fragment", "expected at least 1 particle");
   (void)v;
 }
 
@@ -175,17 +247,39 @@ DebrisResult DebrisMeter::measure(const Frame& frame) const {
   r.axis_point = point_;
   r.total = n;
   r.percentile = opt_.percentile;
+  r.link = link_;
+  r.min_fragment = opt_.min_fragment;
   std::vector<double> front, width;
+  std::vector<Vec3> cloud;
   for (std::size_t i = 0; i < n; ++i) {
     const double d = direction_ * (x[i * dim_ + axis_] - plane_);
     if (!(d > 0)) continue;
     double r2 = 0;
-    for (int a = 0; a < dim_; ++a)
+    Vec3 p = Vec3::Zero();
+    for (int a = 0; a < dim_; ++a) {
+      p[a] = x[i * dim_ + a];
       if (a != axis_) r2 += (x[i * dim_ + a] - point_[a]) * (x[i * dim_ + a] - point_[a]);
+    }
     front.push_back(d);
     width.push_back(2 * std::sqrt(r2));
+    cloud.push_back(p);
   }
   r.cloud = front.size();
+  if (front.empty()) return r;
+  // Fragments; only the particles of fragments of at least min_fragment particles count.
+  const std::vector<std::size_t> size = fragment_sizes(cloud, link_);
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < size.size(); ++i) {
+    r.largest = std::max(r.largest, size[i]);
+    if (size[i] == 1) ++r.singles;
+    if (size[i] >= opt_.min_fragment) front[kept] = front[i], width[kept] = width[i], ++kept;
+  }
+  double fragments = 0;  // a fragment of k particles: k particles of 1 / k each
+  for (const std::size_t k : size) fragments += 1.0 / double(k);
+  r.fragments = std::size_t(std::llround(fragments));
+  front.resize(kept);
+  width.resize(kept);
+  r.counted = kept;
   if (front.empty()) return r;
   r.front_max = *std::max_element(front.begin(), front.end());
   r.width_max = *std::max_element(width.begin(), width.end());

@@ -51,6 +51,11 @@ struct DebrisOptions {
   std::string target;          ///< target body; empty: the first body at rest at t = 0
   std::string projectile;      ///< projectile body; empty: the fastest body at t = 0
   double percentile = 99.5;    ///< the headline front and width are this percentile
+  /// Fragments: cloud particles closer than `link` belong to one fragment (friends of
+  /// friends); only fragments of at least `min_fragment` particles count. 0: the grid's cell
+  /// size (particles closer than a cell share grid nodes, so the grid moves them together).
+  double link = 0;
+  std::size_t min_fragment = 1;  ///< 1: every cloud particle counts
 };
 
 struct DebrisResult {
@@ -65,7 +70,16 @@ struct DebrisResult {
   /// the maximum, the 99th, 99.5th and 99.9th percentiles, and the headline percentile.
   double front_max = 0, front_p99 = 0, front_p995 = 0, front_p999 = 0, front = 0;
   double width_max = 0, width_p99 = 0, width_p995 = 0, width_p999 = 0, width = 0;
+  /// Fragments of the cloud at linking length `link` (m): how many, how many of one particle,
+  /// the particles of the largest; `counted` cloud particles lie in fragments of at least
+  /// `min_fragment` particles, and the distances above are theirs.
+  double link = 0;
+  std::size_t min_fragment = 1, fragments = 0, singles = 0, largest = 0, counted = 0;
 };
+
+/// Fragments of a point set, friends of friends: points closer than `link` are in one
+/// fragment. Returns, for each point, the number of points of its fragment.
+std::vector<std::size_t> fragment_sizes(const std::vector<Vec3>& points, double link);
 
 /// Measures debris clouds: set up from the first frame (axis, plane), then measure any frame.
 /// The cloud is every particle downstream of the plane (the target's rear face, at the surface:
@@ -83,6 +97,7 @@ class DebrisMeter {
   double plane_ = 0;
   Vec3 point_ = Vec3::Zero();
   int dim_ = 3;
+  double link_ = 0;
 };
 
 }  // namespace mpm

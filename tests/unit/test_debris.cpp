@@ -3,6 +3,7 @@
 // maximum and the percentiles of front and width.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 
 #include "mpm/particles.hpp"
@@ -83,6 +84,80 @@ TEST(Debris, PlaneAxisPercentilesAndMaximum) {
   const DebrisResult q = DebrisMeter(scene, start.frame(0), p90).measure(later.frame(30e-6));
   EXPECT_NEAR(q.front, 0.900, tol);
   EXPECT_NEAR(q.width, 0.900, tol);
+}
+
+// Friends of friends: points closer than the linking length are one fragment, transitively,
+// across the bins of the search; points farther apart are not.
+TEST(Debris, FragmentsLinkTransitivelyAcrossBins) {
+  const double link = 1e-3;
+  std::vector<Vec3> chain, gaps;
+  for (int k = 0; k < 40; ++k) {
+    chain.push_back(Vec3(0.9e-3 * k, 0.3e-3 * (k % 2), -0.2e-3 * (k % 2)));  // steps 0.97 mm
+    gaps.push_back(Vec3(1.01e-3 * k, 0, 0));                                 // steps 1.01 mm
+  }
+  for (const std::size_t s : fragment_sizes(chain, link)) EXPECT_EQ(s, 40u);
+  for (const std::size_t s : fragment_sizes(gaps, link)) EXPECT_EQ(s, 1u);
+  // Two blocks of 3 x 3 x 3 points 0.5 mm apart, 0.9 mm and 1.1 mm between their faces.
+  std::vector<Vec3> blocks;
+  for (const double x0 : {0.0, 1.9e-3, 5.1e-3})
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        for (int k = 0; k < 3; ++k) blocks.push_back(Vec3(x0 + 0.5e-3 * i, 0.5e-3 * j, 0.5e-3 * k));
+  const std::vector<std::size_t> s = fragment_sizes(blocks, link);
+  for (std::size_t i = 0; i < 54; ++i) EXPECT_EQ(s[i], 54u);  // 1.9 - 1.0 = 0.9 mm: linked
+  for (std::size_t i = 54; i < 81; ++i) EXPECT_EQ(s[i], 27u);  // 5.1 - 2.9 = 2.2 mm: apart
+}
+
+// Only particles of fragments of at least --min-fragment particles count: isolated particles
+// ahead of the cloud no longer set its front and width.
+TEST(Debris, MinFragmentDropsIsolatedParticles) {
+  const Scene scene = two_bodies();  // 2 mm cells: the default linking length
+  Cloud start;
+  for (int i = 0; i <= 5; ++i)
+    for (int j = -10; j <= 10; ++j) start.add(Vec3(i * kS, j * kS, 0), 0);
+  for (int i = -3; i <= -1; ++i) start.add(Vec3(i * kS, 1e-3, 1e-3), 1);
+  // Behind the rear face (5.5 mm): a 5 x 5 x 5 block of particles 1 mm apart, its front face
+  // 50 mm behind the plane and 4 mm off the axis at most; a pair 1.5 mm apart 60 mm behind;
+  // three particles alone, 100, 120 and 140 mm behind, the last 80 mm off the axis.
+  Cloud later;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j)
+      for (int k = 0; k < 5; ++k)
+        later.add(Vec3(5.5e-3 + 46e-3 + i * 1e-3, 1e-3 + (j - 2) * 1e-3, 1e-3 + (k - 2) * 1e-3), 1);
+  later.add(Vec3(5.5e-3 + 58.5e-3, 1e-3, 1e-3), 0);
+  later.add(Vec3(5.5e-3 + 60e-3, 1e-3, 1e-3), 0);
+  later.add(Vec3(5.5e-3 + 100e-3, 1e-3, 1e-3), 0);
+  later.add(Vec3(5.5e-3 + 120e-3, 1e-3, 1e-3), 0);
+  later.add(Vec3(5.5e-3 + 140e-3, 1e-3 + 40e-3, 1e-3), 0);
+
+  DebrisOptions all;
+  const DebrisResult a = DebrisMeter(scene, start.frame(0), all).measure(later.frame(30e-6));
+  EXPECT_NEAR(a.link, 2e-3, 1e-15);
+  EXPECT_EQ(a.cloud, 130u);
+  EXPECT_EQ(a.counted, 130u);
+  EXPECT_EQ(a.fragments, 5u);
+  EXPECT_EQ(a.singles, 3u);
+  EXPECT_EQ(a.largest, 125u);
+  EXPECT_NEAR(a.front_max, 0.140, 1e-12);
+  EXPECT_NEAR(a.width_max, 0.080, 1e-12);
+
+  DebrisOptions pairs;
+  pairs.min_fragment = 2;
+  const DebrisResult b = DebrisMeter(scene, start.frame(0), pairs).measure(later.frame(30e-6));
+  EXPECT_EQ(b.counted, 127u);
+  EXPECT_NEAR(b.front_max, 0.060, 1e-12);
+  EXPECT_NEAR(b.width_max, 2 * std::sqrt(8e-6), 1e-12);  // the block's corners, (2, 2) mm off
+  DebrisOptions blocks = pairs;
+  blocks.min_fragment = 3;
+  const DebrisResult c = DebrisMeter(scene, start.frame(0), blocks).measure(later.frame(30e-6));
+  EXPECT_EQ(c.counted, 125u);
+  EXPECT_NEAR(c.front_max, 0.050, 1e-12);
+  // A linking length of 1.4 mm breaks the pair (1.5 mm apart) but keeps the block (1 mm).
+  blocks.min_fragment = 2;
+  blocks.link = 1.4e-3;
+  const DebrisResult d = DebrisMeter(scene, start.frame(0), blocks).measure(later.frame(30e-6));
+  EXPECT_EQ(d.fragments, 6u);
+  EXPECT_EQ(d.counted, 125u);
 }
 
 }  // namespace
