@@ -5,7 +5,9 @@
 /// The time step, ExplicitSolver::step, is at the top of explicit_solver_impl.hpp.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -13,6 +15,7 @@
 
 #include "mpm/binning.hpp"
 #include "mpm/columns.hpp"
+#include "mpm/error.hpp"
 #include "mpm/grid.hpp"
 #include "mpm/lattice.hpp"
 #include "mpm/materials/material.hpp"
@@ -57,6 +60,51 @@ std::size_t account_exits(ColumnStore& particles, std::vector<std::uint32_t>& ex
     balance.internal -= ie;
   }
   return exits.size();
+}
+
+/// Prescribed velocities of the scene's rigid bodies, by body (zero for deformable bodies);
+/// returns whether the scene has a rigid body. Shared by the explicit and implicit solvers.
+template <int D>
+bool rigid_body_velocities(const Scene& scene, std::vector<Vec<D>>& velocity) {
+  velocity.assign(scene.bodies.size(), Vec<D>::Zero());
+  bool any = false;
+  for (std::size_t b = 0; b < scene.bodies.size(); ++b)
+    if (scene.bodies[b].rigid) {
+      any = true;
+      for (int a = 0; a < D; ++a) velocity[b][a] = scene.bodies[b].velocity[a];
+    }
+  return any;
+}
+
+/// Checks that every particle starts inside the grid's domain (InputError naming the first
+/// that does not) and returns the nodal-mass floor below which a node counts as empty: 1e-14
+/// of the lightest deformable particle.
+template <class GridT>
+double check_start_and_mass_floor(const GridT& grid, const ParticleView<GridT::kDim>& p) {
+  double m_min = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < p.n; ++i) {
+    std::int64_t key;
+    Vec<GridT::kDim> xi;
+    if (!p.x[i].allFinite() || grid.where(p.x[i], key, xi) == Where::OutsideDomain)
+      throw InputError("model", "particle " + std::to_string(p.id[i]) + " lies outside the domain of the grid");
+    if (p.material[i] != kRigidMaterial) m_min = std::min(m_min, p.m[i]);
+  }
+  return 1e-14 * (std::isfinite(m_min) ? m_min : 1.0);
+}
+
+/// Adds the deformable particles' kinetic and internal energy and momentum to `balance` and
+/// returns the fastest signal, max(reference wave speed + |v|), which sets the first step.
+template <int D>
+double start_balance(const ParticleView<D>& p, const std::vector<Material>& materials, Balance& balance) {
+  double speed = 0;
+  for (std::size_t i = 0; i < p.n; ++i) {
+    if (p.material[i] == kRigidMaterial) continue;
+    balance.kinetic += 0.5 * p.m[i] * p.v[i].squaredNorm();
+    balance.internal += p.m[i] * p.e[i];
+    for (int a = 0; a < D; ++a) balance.momentum[a] += p.m[i] * p.v[i][a];
+    speed = std::max(speed, materials[p.material[i]].reference_wave_speed() + p.v[i].norm());
+  }
+  return speed;
 }
 
 /// How the particle-to-grid scatters avoid write races without locks or atomics.

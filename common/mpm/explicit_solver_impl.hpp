@@ -92,43 +92,19 @@ ExplicitSolver<GridT>::ExplicitSolver(const Scene& scene, GridT grid, ColumnStor
   prepare_columns(particles_, scene_);
   for (const auto& m : scene_.materials) materials_.emplace_back(m, scene_.solver);
   for (int a = 0; a < D; ++a) gravity_[a] = scene_.solver.gravity[a];
-  rigid_velocity_.assign(scene_.bodies.size(), Vec<D>::Zero());
+  has_rigid_ = rigid_body_velocities<D>(scene_, rigid_velocity_);
   rigid_force_.assign(scene_.bodies.size(), Vec3::Zero());
-  for (std::size_t b = 0; b < scene_.bodies.size(); ++b)
-    if (scene_.bodies[b].rigid) {
-      has_rigid_ = true;
-      for (int a = 0; a < D; ++a) rigid_velocity_[b][a] = scene_.bodies[b].velocity[a];
-    }
   const int threads = omp_get_max_threads();
   if (strategy_ == ScatterStrategy::LRSlabs) binning_.target_chunks = 2 * threads;
   strays_.resize(threads);
   scratch_.resize(threads);
   for (auto& s : scratch_) s = std::make_unique<StressScratch>();
 
-  // Every particle must start inside the domain.
-  ParticleView<D> p = view<D>(particles_);
-  double m_min = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < p.n; ++i) {
-    std::int64_t key;
-    Vec<D> xi;
-    if (!p.x[i].allFinite() || grid_.where(p.x[i], key, xi) == Where::OutsideDomain)
-      throw InputError("model", "particle " + std::to_string(p.id[i]) +
-                                    " lies outside the domain of the grid");
-    if (p.material[i] != kRigidMaterial) m_min = std::min(m_min, p.m[i]);
-  }
-  node_mass_floor_ = 1e-14 * (std::isfinite(m_min) ? m_min : 1.0);
+  node_mass_floor_ = check_start_and_mass_floor(grid_, view<D>(particles_));
   sort_particles();
 
   // Initial energies and the first stable time step.
-  p = view<D>(particles_);
-  double speed = 0;
-  for (std::size_t i = 0; i < p.n; ++i) {
-    if (p.material[i] == kRigidMaterial) continue;
-    balance_.kinetic += 0.5 * p.m[i] * p.v[i].squaredNorm();
-    balance_.internal += p.m[i] * p.e[i];
-    for (int a = 0; a < D; ++a) balance_.momentum[a] += p.m[i] * p.v[i][a];
-    speed = std::max(speed, materials_[p.material[i]].reference_wave_speed() + p.v[i].norm());
-  }
+  const double speed = start_balance<D>(view<D>(particles_), materials_, balance_);
   total0_ = balance_.leapfrog_total = balance_.total();
   energy_scale_ = std::max(std::abs(total0_), balance_.kinetic);
   const double h = grid_.min_cell_size();

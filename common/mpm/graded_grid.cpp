@@ -442,25 +442,8 @@ bool GradedGrid<D>::build(bool validate) {
 
 template <int D>
 void GradedGrid<D>::fit(const Vec<D>* x, std::size_t n, int margin) {
-  // Level-1 cells of the particles (a parallel min/max, as UniformGrid::fit).
-  IVec<D> lo = cells1_, hi = IVec<D>::Constant(-1);
-#pragma omp parallel
-  {
-    IVec<D> tlo = cells1_, thi = IVec<D>::Constant(-1);
-#pragma omp for schedule(static) nowait
-    for (std::size_t i = 0; i < n; ++i)
-      for (int a = 0; a < D; ++a) {
-        const int c = int(std::floor((x[i][a] - origin_[a]) * inv_h1_));
-        tlo[a] = std::min(tlo[a], c);
-        thi[a] = std::max(thi[a], c);
-      }
-#pragma omp critical
-    {
-      lo = lo.cwiseMin(tlo);
-      hi = hi.cwiseMax(thi);
-    }
-  }
-  if (n == 0) lo.setZero(), hi.setZero();
+  IVec<D> lo, hi;  // level-1 cells of the particles
+  cell_bounds<D>(x, n, origin_, inv_h1_, cells1_, lo, hi);
   auto clamp = [&](int pad, IVec<D>& wlo, IVec<D>& whi) {
     for (int a = 0; a < D; ++a) {
       wlo[a] = std::clamp(lo[a] - pad, 0, cells1_[a]);

@@ -22,26 +22,8 @@ UniformGrid<D>::UniformGrid(const Lattice& lattice, const BoundarySpec& boundary
 
 template <int D>
 void UniformGrid<D>::fit(const Vec<D>* x, std::size_t n, int margin) {
-  // Bounding box of the particles' cells (a parallel min/max).
-  IVec<D> lo = cells_, hi = IVec<D>::Constant(-1);
-#pragma omp parallel
-  {
-    IVec<D> tlo = cells_, thi = IVec<D>::Constant(-1);
-#pragma omp for schedule(static) nowait
-    for (std::size_t i = 0; i < n; ++i) {
-      IVec<D> c;
-      Vec<D> xi;
-      locate(x[i], c, xi);
-      tlo = tlo.cwiseMin(c);
-      thi = thi.cwiseMax(c);
-    }
-#pragma omp critical
-    {
-      lo = lo.cwiseMin(tlo);
-      hi = hi.cwiseMax(thi);
-    }
-  }
-  if (n == 0) lo.setZero(), hi.setZero();
+  IVec<D> lo, hi;  // the particles' cells
+  cell_bounds<D>(x, n, origin_, inv_h_, cells_, lo, hi);
   for (int a = 0; a < D; ++a) {
     lo_[a] = std::max(0, lo[a] - margin);
     hi_[a] = std::min(cells_[a] - 1, hi[a] + margin);

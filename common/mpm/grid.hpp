@@ -4,7 +4,9 @@
 /// the grid follows the material). Boundary conditions sit on the domain's faces and are
 /// applied to the window's nodes that lie on those faces, so the window changes nothing of
 /// the result: a node outside the window has no mass and no influence.
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -17,6 +19,32 @@ namespace mpm {
 
 /// Where a point lies relative to a grid.
 enum class Where : std::uint8_t { Window, OutsideWindow, OutsideDomain };
+
+/// The bounding box [lo, hi] of the lattice cells (side 1 / inv_h, counted from origin) that
+/// hold the points x[0, n): a parallel min/max, the first half of every grid's fit(). lo and
+/// hi are 0 when n = 0; points must lie inside the `cells` of the domain.
+template <int D>
+void cell_bounds(const Vec<D>* x, std::size_t n, const Vec<D>& origin, double inv_h,
+                 const IVec<D>& cells, IVec<D>& lo, IVec<D>& hi) {
+  lo = cells, hi = IVec<D>::Constant(-1);
+#pragma omp parallel
+  {
+    IVec<D> tlo = cells, thi = IVec<D>::Constant(-1);
+#pragma omp for schedule(static) nowait
+    for (std::size_t i = 0; i < n; ++i)
+      for (int a = 0; a < D; ++a) {
+        const int c = int(std::floor((x[i][a] - origin[a]) * inv_h));
+        tlo[a] = std::min(tlo[a], c);
+        thi[a] = std::max(thi[a], c);
+      }
+#pragma omp critical
+    {
+      lo = lo.cwiseMin(tlo);
+      hi = hi.cwiseMax(thi);
+    }
+  }
+  if (n == 0) lo.setZero(), hi.setZero();
+}
 
 // What the kernels need of a grid (UniformGrid here; a graded grid provides the same):
 //   static constexpr int kMaxNodes;     nodes of a cell, at most

@@ -254,7 +254,7 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
       }
       if (solver.time() >= next_frame * (1 - 1e-12)) {
         if (history.pending() == 0 || o.history_interval > 0) history.record(solver, dt);
-        emit_frame(frame == o.frames ? kFrameFinal : 0);
+        emit_frame(frame == o.frames ? std::uint32_t(kFrameFinal) : 0u);
         ++frame;
         next_frame = frame <= o.frames ? end * frame / o.frames : end;
       }

@@ -119,7 +119,7 @@ with open(f"{study}/table.md", "w") as f:
         mean = sum(errs) / len(errs)
         f.write(f"| {label} | {st['cells']} | {st['particles']} | {st['steps']} | {st['run']:.1f} | "
                 f"{st['rate']:.2f} | " + " | ".join(f"{100 * e:.2f}%" for e in errs) +
-                f" | {100 * mean:.2f}% | {mean / fine:.2f}x | {100 * r70:+.2f}% | {100 * r30:+.2f}% |\n")
+                f" | {100 * mean:.2f}% | {mean / fine:.3f}x | {100 * r70:+.2f}% | {100 * r30:+.2f}% |\n")
     f.write(f"\nL2 error: sqrt(sum V_p (sigma_p - sigma_exact(x_p))^2 / sum V_p) / (F/A), over every "
             f"particle, F/A = {s0 / 1e6:.4f} MPa, c = {c:.1f} m/s. Reflected: the mean sigma_xx over "
             f"x in [71, 79] mm at 9 us and [31, 39.5] mm at 18 us, where the exact stress is F/A, "

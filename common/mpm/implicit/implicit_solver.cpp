@@ -153,13 +153,8 @@ ImplicitSolver<GridT>::ImplicitSolver(const Scene& scene, GridT grid, ColumnStor
     youngs_max_ = std::max(youngs_max_, m.youngs_modulus);
   }
   for (int a = 0; a < D; ++a) gravity_[a] = scene_.solver.gravity[a];
-  rigid_velocity_.assign(scene_.bodies.size(), Vec<D>::Zero());
+  has_rigid_ = rigid_body_velocities<D>(scene_, rigid_velocity_);
   rigid_force_.assign(scene_.bodies.size(), Vec3::Zero());
-  for (std::size_t b = 0; b < scene_.bodies.size(); ++b)
-    if (scene_.bodies[b].rigid) {
-      has_rigid_ = true;
-      for (int a = 0; a < D; ++a) rigid_velocity_[b][a] = scene_.bodies[b].velocity[a];
-    }
   const int threads = omp_get_max_threads();
   scratch_.resize(threads);
   for (auto& s : scratch_) s = std::make_unique<Scratch>();
@@ -167,32 +162,16 @@ ImplicitSolver<GridT>::ImplicitSolver(const Scene& scene, GridT grid, ColumnStor
   accepted_ = std::make_unique<Trial>();
   system_ = std::make_unique<System>(*this);
 
-  // Every particle must start inside the domain.
-  ParticleView<D> p = view<D>(particles_);
-  double m_min = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < p.n; ++i) {
-    std::int64_t key;
-    Vec<D> xi;
-    if (!p.x[i].allFinite() || grid_.where(p.x[i], key, xi) == Where::OutsideDomain)
-      throw InputError(
-          "model", "particle " + std::to_string(p.id[i]) + " lies outside the domain of the grid");
-    if (p.material[i] != kRigidMaterial) m_min = std::min(m_min, p.m[i]);
-  }
-  node_mass_floor_ = 1e-14 * (std::isfinite(m_min) ? m_min : 1.0);
+  const ParticleView<D> p = view<D>(particles_);
+  node_mass_floor_ = check_start_and_mass_floor(grid_, p);
 
   // Initial energies, the explicit step the multiples refer to, and the residual's cell
   // measure: dx dy in plane strain (per metre, as the seed's), dx dy r_ref in axisymmetry
   // (per radian; r_ref the mass-weighted mean radius), dx dy dz in 3D.
-  double speed = 0, m_sum = 0, mr_sum = 0;
-  for (std::size_t i = 0; i < p.n; ++i) {
-    if (p.material[i] == kRigidMaterial) continue;
-    balance_.kinetic += 0.5 * p.m[i] * p.v[i].squaredNorm();
-    balance_.internal += p.m[i] * p.e[i];
-    for (int a = 0; a < D; ++a) balance_.momentum[a] += p.m[i] * p.v[i][a];
-    speed = std::max(speed, materials_[p.material[i]].reference_wave_speed() + p.v[i].norm());
-    m_sum += p.m[i];
-    mr_sum += p.m[i] * p.x[i][0];
-  }
+  const double speed = start_balance<D>(p, materials_, balance_);
+  double m_sum = 0, mr_sum = 0;
+  for (std::size_t i = 0; i < p.n; ++i)
+    if (p.material[i] != kRigidMaterial) m_sum += p.m[i], mr_sum += p.m[i] * p.x[i][0];
   balance_.leapfrog_total = total0_ = balance_.total();
   energy_scale_ = std::max(std::abs(total0_), balance_.kinetic);
   const double h = grid_.min_cell_size();
