@@ -130,7 +130,11 @@ void Material::update(MaterialBlock& b, BlockScratch& S) const {
     b.sigma[i] = sigma;
     // Signal speed for the time step, widened by the viscosity as in hydrocodes:
     // dt <= h / (Q + sqrt(Q^2 + c^2)), Q = C1 c + C0 h |tr D| in compression.
-    const double c = std::sqrt((std::max(S.K[i], 0.0) + 4.0 / 3.0 * G_) / rho);
+    // Isentropic bulk modulus K_s = rho dp/drho at constant entropy: with p = A(rho) + B e
+    // and de = p / rho^2 drho, K_s = K + B p / rho (K = rho dA/drho from the EOS). The thermal
+    // term matters behind strong shocks and in hot expanded material.
+    const double K_s = std::max(S.K[i], 0.0) + (p > 0 ? S.B[i] * p / rho : 0.0);
+    const double c = std::sqrt((K_s + 4.0 / 3.0 * G_) / rho);
     const double Q = trD < 0 ? bulk_linear_ * c + bulk_quadratic_ * b.h * (-trD) : 0.0;
     b.c[i] = Q + std::sqrt(Q * Q + c * c);
     if (!std::isfinite(b.e[i]) || !sigma.allFinite() || !std::isfinite(rho)) {
