@@ -144,18 +144,16 @@ std::vector<std::size_t> fragment_sizes(const std::vector<Vec3>& points, double 
   }
   std::sort(bins.begin(), bins.end());
   const double link2 = link * link;
-  auto range = [&](std::uint64_t k) {
-    auto first = std::lower_bound(bins.begin(), bins.end(), std::make_pair(k, std::size_t(0)));
-    auto last = first;
-    while (last != bins.end() && last->first == k) ++last;
-    return std::make_pair(first, last);
+  struct ByKey {
+    bool operator()(const std::pair<std::uint64_t, std::size_t>& b, std::uint64_t k) const { return b.first < k; }
+    bool operator()(std::uint64_t k, const std::pair<std::uint64_t, std::size_t>& b) const { return k < b.first; }
   };
+  auto range = [&](std::uint64_t k) { return std::equal_range(bins.begin(), bins.end(), k, ByKey{}); };
   // Each bin against itself and its 13 neighbours that come after it.
   for (auto b = bins.begin(); b != bins.end();) {
     const std::size_t i0 = b->second;
     const std::int64_t c[3] = {cell(points[i0], 0), cell(points[i0], 1), cell(points[i0], 2)};
-    auto e = b;
-    while (e != bins.end() && e->first == b->first) ++e;
+    const auto e = range(b->first).second;
     for (auto p = b; p != e; ++p)
       for (auto q = p + 1; q != e; ++q)
         if ((points[p->second] - points[q->second]).squaredNorm() < link2) join(p->second, q->second);
