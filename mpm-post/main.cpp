@@ -205,7 +205,12 @@ int cmd_history(const std::string& path, const std::string& out, const std::vect
 
 // vtk -------------------------------------------------------------------------------------
 int cmd_vtk(const std::string& path, const std::string& dir, const std::string& name, int every) {
-  std::filesystem::create_directories(dir);
+  std::error_code ec;
+  if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
+    throw InputError("-o " + dir, "exists and is not a directory (vtk writes a directory of .vtu "
+                                  "files and a .pvd series)");
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw IoError("cannot create the directory '" + dir + "': " + ec.message());
   std::vector<std::pair<double, std::string>> entries;
   std::size_t index = 0;
   StreamVisitor v;
@@ -780,6 +785,11 @@ int main(int argc, char** argv) {
   }
   return mpm::guarded_main("mpm-post", [&]() -> int {
     mpm::ignore_sigpipe();
+    // No subcommand writes over the stream it reads.
+    if (*history) mpm::refuse_output_over_input(hist_out, {input});
+    if (*particles) mpm::refuse_output_over_input(part_out, {input});
+    if (*profile) mpm::refuse_output_over_input(pa.output, {input});
+    if (*render) mpm::refuse_output_over_input(ra.output, {input});
     if (*summary) return cmd_summary(input, summary_json);
     if (*history) return cmd_history(input, hist_out, hist_cols);
     if (*particles) return cmd_particles(input, part_out, part_frame, part_cols);

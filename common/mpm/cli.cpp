@@ -4,6 +4,7 @@
 
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <new>
 
 #include "mpm/error.hpp"
@@ -32,6 +33,17 @@ void refuse_terminal_output(const std::string& path, const char* what) {
   if (path == "-" && isatty(1))
     throw InputError("-o", std::string("standard output is a terminal; ") + what +
                                " is binary: pipe it into the next tool or write it with -o FILE");
+}
+
+void refuse_output_over_input(const std::string& output, const std::vector<std::string>& inputs) {
+  if (output == "-") return;
+  for (const auto& input : inputs) {
+    if (input == "-") continue;
+    std::error_code ec;
+    if (std::filesystem::equivalent(output, input, ec) && !ec)
+      throw InputError("-o " + output, "is the input file '" + input +
+                                           "'; writing it would destroy the input: choose another output file");
+  }
 }
 
 void ignore_sigpipe() { std::signal(SIGPIPE, SIG_IGN); }

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <toml++/toml.h>
 
+#include "mpm/cli.hpp"
 #include "mpm/error.hpp"
 #include "mpm/graded_voxelise.hpp"
 #include "mpm/lattice.hpp"
@@ -144,6 +145,10 @@ int prepare_model(const PrepOptions& opt) {
                    scene.solver.cfl);
   }
 
+  std::vector<std::string> inputs{opt.scene};
+  for (const auto& b : scene.bodies)
+    if (!b.mesh_path.empty()) inputs.push_back(b.mesh_path);
+  refuse_output_over_input(opt.output, inputs);
   StreamWriter out(opt.output);
   out.write_text(RecordType::Scene, text);
   std::ostringstream info;

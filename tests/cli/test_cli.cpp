@@ -176,6 +176,51 @@ TEST(Cli, UnstableRunStopsAndKeepsItsFrames) {
   EXPECT_EQ(r.status, 3);  // the run's failure propagates to scripts
 }
 
+// Nothing the user made is lost: no tool writes its output over its own input, by any name
+// (a link, a relative path); the input stays byte for byte as it was, and the error is an
+// input error (status 2). mpm-post vtk refuses an -o that is a file, not a directory.
+TEST(Cli, OutputOverItsOwnInputIsRefused) {
+  const auto dir = temp_dir("overwrite");
+  const fs::path scene = dir / "scene.toml", mesh = dir / "box.stl";
+  fs::copy_file(fs::path(MPM_TEST_DATA) / "meshes" / "box_12.stl", mesh);
+  {
+    std::ofstream f(scene);
+    f << slurp(kBlock) << "\n[[bodies]]\nname = \"meshed\"\nmaterial = \"steel\"\n"
+      << "shape = \"mesh\"\nfile = \"box.stl\"\nscale = 0.001\ntranslate = \"0 0 6 mm\"\n";
+  }
+  const std::string scene_before = slurp(scene), mesh_before = slurp(mesh);
+  const fs::path model = dir / "model.mpm", result = dir / "result.mpm";
+  const std::string cd = "cd " + dir.string() + " && ";
+  Result r = run(cd + prep + " scene.toml -q -o model.mpm", dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run(cd + runner + " --progress none model.mpm -o result.mpm", dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string model_before = slurp(model), result_before = slurp(result);
+  fs::create_symlink(result, dir / "link.mpm");
+
+  const std::vector<std::string> commands = {
+      prep + " scene.toml -o ./scene.toml",
+      prep + " scene.toml -o box.stl",
+      runner + " model.mpm -o " + model.string(),
+      post + " history result.mpm -o link.mpm",
+      post + " particles link.mpm -o result.mpm",
+      post + " profile result.mpm --field speed --along z --bins 4 -o link.mpm",
+      post + " render result.mpm -o link.mpm",
+  };
+  for (const auto& c : commands) {
+    r = run(cd + c, dir);
+    EXPECT_EQ(r.status, 2) << c << "\n" << r.err;
+    EXPECT_NE(r.err.find("is the input file"), std::string::npos) << c << "\n" << r.err;
+  }
+  r = run(cd + post + " vtk result.mpm -o result.mpm", dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("is not a directory"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(scene), scene_before);
+  EXPECT_EQ(slurp(mesh), mesh_before);
+  EXPECT_EQ(slurp(model), model_before);
+  EXPECT_EQ(slurp(result), result_before);
+}
+
 }  // namespace
 }  // namespace mpm
 
