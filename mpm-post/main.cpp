@@ -786,10 +786,10 @@ int main(int argc, char** argv) {
   return mpm::guarded_main("mpm-post", [&]() -> int {
     mpm::ignore_sigpipe();
     // No subcommand writes over the stream it reads.
-    if (*history) mpm::refuse_output_over_input(hist_out, {input});
-    if (*particles) mpm::refuse_output_over_input(part_out, {input});
-    if (*profile) mpm::refuse_output_over_input(pa.output, {input});
-    if (*render) mpm::refuse_output_over_input(ra.output, {input});
+    if (*history) mpm::check_output_file(hist_out, {input});
+    if (*particles) mpm::check_output_file(part_out, {input});
+    if (*profile) mpm::check_output_file(pa.output, {input});
+    if (*render) mpm::check_output_file(ra.output, {input});
     if (*summary) return cmd_summary(input, summary_json);
     if (*history) return cmd_history(input, hist_out, hist_cols);
     if (*particles) return cmd_particles(input, part_out, part_frame, part_cols);

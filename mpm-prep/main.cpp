@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
   return mpm::guarded_main("mpm-prep", [&] {
     mpm::ignore_sigpipe();
     mpm::refuse_terminal_output(opt.output, "the model stream");
-    mpm::refuse_output_over_input(opt.output, {opt.scene});
+    mpm::check_output_file(opt.output, {opt.scene});
     return mpm::prepare_model(opt);
   });
 }

@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
   return mpm::guarded_main("mpm-run", [&] {
     mpm::ignore_sigpipe();
     mpm::refuse_terminal_output(opt.output, "the result stream");
-    mpm::refuse_output_over_input(opt.output, {opt.input});
+    mpm::check_output_file(opt.output, {opt.input});
     return mpm::run_model(opt);
   });
 }

@@ -35,11 +35,13 @@ void refuse_terminal_output(const std::string& path, const char* what) {
                                " is binary: pipe it into the next tool or write it with -o FILE");
 }
 
-void refuse_output_over_input(const std::string& output, const std::vector<std::string>& inputs) {
+void check_output_file(const std::string& output, const std::vector<std::string>& inputs) {
   if (output == "-") return;
+  std::error_code ec;
+  if (std::filesystem::is_directory(output, ec))
+    throw InputError("-o " + output, "is a directory; expected the name of a file to write");
   for (const auto& input : inputs) {
     if (input == "-") continue;
-    std::error_code ec;
     if (std::filesystem::equivalent(output, input, ec) && !ec)
       throw InputError("-o " + output, "is the input file '" + input +
                                            "'; writing it would destroy the input: choose another output file");

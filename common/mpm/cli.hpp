@@ -14,10 +14,11 @@ int guarded_main(const char* tool, const std::function<int()>& body);
 /// garbage there).
 void refuse_terminal_output(const std::string& path, const char* what);
 
-/// Throws InputError when the output file `output` is one of the `inputs` (the same file by
-/// any name: links and relative paths are resolved). Writing it would destroy the input before
-/// or while it is read. "-" (a pipe) never collides, nor does an output that does not exist yet.
-void refuse_output_over_input(const std::string& output, const std::vector<std::string>& inputs);
+/// Throws InputError when the output file `output` is a directory, or is one of the `inputs`
+/// (the same file by any name: links and relative paths are resolved): writing it would
+/// destroy the input before or while it is read. "-" (a pipe) passes, and so does an output
+/// that does not exist yet.
+void check_output_file(const std::string& output, const std::vector<std::string>& inputs);
 
 /// Ignores SIGPIPE so that a closed pipe shows up as a write error (IoError) with a message.
 void ignore_sigpipe();

@@ -148,7 +148,7 @@ int prepare_model(const PrepOptions& opt) {
   std::vector<std::string> inputs{opt.scene};
   for (const auto& b : scene.bodies)
     if (!b.mesh_path.empty()) inputs.push_back(b.mesh_path);
-  refuse_output_over_input(opt.output, inputs);
+  check_output_file(opt.output, inputs);
   StreamWriter out(opt.output);
   out.write_text(RecordType::Scene, text);
   std::ostringstream info;

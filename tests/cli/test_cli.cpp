@@ -178,7 +178,8 @@ TEST(Cli, UnstableRunStopsAndKeepsItsFrames) {
 
 // Nothing the user made is lost: no tool writes its output over its own input, by any name
 // (a link, a relative path); the input stays byte for byte as it was, and the error is an
-// input error (status 2). mpm-post vtk refuses an -o that is a file, not a directory.
+// input error (status 2). An -o that is a directory is an input error too, except for
+// mpm-post vtk, which writes a directory and refuses an -o that is a file.
 TEST(Cli, OutputOverItsOwnInputIsRefused) {
   const auto dir = temp_dir("overwrite");
   const fs::path scene = dir / "scene.toml", mesh = dir / "box.stl";
@@ -211,6 +212,13 @@ TEST(Cli, OutputOverItsOwnInputIsRefused) {
     r = run(cd + c, dir);
     EXPECT_EQ(r.status, 2) << c << "\n" << r.err;
     EXPECT_NE(r.err.find("is the input file"), std::string::npos) << c << "\n" << r.err;
+  }
+  // An output that is a directory (VTK's PNG writer used to spin on one for ever).
+  for (const std::string& c : {prep + " scene.toml -o .", runner + " model.mpm -o .",
+                               post + " history result.mpm -o .", post + " render result.mpm -o ."}) {
+    r = run(cd + "timeout 120 " + c, dir);
+    EXPECT_EQ(r.status, 2) << c << "\n" << r.err;
+    EXPECT_NE(r.err.find("is a directory"), std::string::npos) << c << "\n" << r.err;
   }
   r = run(cd + post + " vtk result.mpm -o result.mpm", dir);
   EXPECT_EQ(r.status, 2) << r.err;

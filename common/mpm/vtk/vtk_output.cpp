@@ -115,6 +115,8 @@ class FileTarget {
  public:
   explicit FileTarget(std::string path) : path_(std::move(path)) {
     std::error_code ec;
+    if (std::filesystem::is_directory(path_, ec))  // VTK's writers spin on a directory
+      throw InputError(path_, "is a directory; expected the name of a file to write");
     const auto st = std::filesystem::symlink_status(path_, ec);
     const bool special = !ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st);
     write_path_ = special ? path_ : path_ + ".tmp" + std::to_string(::getpid());
