@@ -72,7 +72,9 @@ int prepare_model(const PrepOptions& opt) {
     for (std::size_t i = 0; i < cols.size(); ++i) {
       double s2 = 0;
       for (int a = 0; a < d; ++a) s2 += v[i * d + a] * v[i * d + a];
-      speed = std::max(speed, c[mat[i]] + std::sqrt(s2));
+      // Rigid bodies (kRigidMaterial) carry no waves: only their speed counts.
+      const double ci = mat[i] == kRigidMaterial ? 0.0 : c[mat[i]];
+      speed = std::max(speed, ci + std::sqrt(s2));
     }
   }
   const double dt = std::min(scene.solver.dt_max, scene.solver.cfl * h_min / speed);
