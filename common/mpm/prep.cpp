@@ -145,6 +145,11 @@ int prepare_model(const PrepOptions& opt) {
     if (scene.solver.cfl > 1.0)
       std::fprintf(stderr, "  warning: solver.cfl = %g exceeds 1; explicit MPM is then unstable\n",
                    scene.solver.cfl);
+    if (steps > 1e8 && scene.solver.type == SolverType::Explicit)
+      std::fprintf(stderr,
+                   "  warning: about %.3g explicit steps; check the materials' density and moduli, "
+                   "grid.cell_size, solver.dt_max and solver.end_time\n",
+                   steps);
   }
 
   std::vector<std::string> inputs{opt.scene};

@@ -176,6 +176,20 @@ TEST(Cli, UnstableRunStopsAndKeepsItsFrames) {
   EXPECT_EQ(r.status, 3);  // the run's failure propagates to scripts
 }
 
+// A scene whose step count is absurd (a density typed in the wrong unit) gets a warning from
+// mpm-prep before anyone waits for the run; the base scene gets none.
+TEST(Cli, PrepWarnsOfAnAbsurdStepCount) {
+  const auto dir = temp_dir("steps");
+  Result r = run(prep + " " + kBlock.string() + " -o " + (dir / "m.mpm").string(), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  r = run(prep + " " + kBlock.string() + " --set materials.steel.density=7.8e-12 -o " +
+              (dir / "m.mpm").string(), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: about"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("explicit steps"), std::string::npos) << r.err;
+}
+
 // Nothing the user made is lost: no tool writes its output over its own input, by any name
 // (a link, a relative path); the input stays byte for byte as it was, and the error is an
 // input error (status 2). An -o that is a directory is an input error too, except for
