@@ -293,6 +293,8 @@ int cmd_taylor(const std::string& path, const TaylorArgs& a) {
                 json_number(r.time).c_str(), json_string(r.measure).c_str(), json_number(r.L).c_str(),
                 json_number(r.D).c_str(), json_number(r.L0).c_str(), json_number(r.D0).c_str(),
                 "xyz"[r.axis], json_number(r.wall).c_str(), json_number(r.spacing).c_str(), r.particles);
+    std::printf(", \"D_min\": %s, \"D_max\": %s, \"D_radius\": %s", json_number(r.D_min).c_str(),
+                json_number(r.D_max).c_str(), json_number(r.D_radius).c_str());
     if (eL) std::printf(", \"expected_L\": %s, \"error_L\": %s", json_number(*eL).c_str(), json_number(r.L / *eL - 1).c_str());
     if (eD) std::printf(", \"expected_D\": %s, \"error_D\": %s", json_number(*eD).c_str(), json_number(r.D / *eD - 1).c_str());
     std::printf("}\n");
@@ -306,6 +308,9 @@ int cmd_taylor(const std::string& path, const TaylorArgs& a) {
     std::printf("  D = %.3f mm", r.D * 1e3);
     if (eD) std::printf("   expected %.3f mm, %+.2f%%", *eD * 1e3, 100 * (r.D / *eD - 1));
     std::printf("   (D0 = %.3f mm, D/D0 = %.4f)\n", r.D0 * 1e3, r.D / r.D0);
+    if (r.D_max > r.D_min)
+      std::printf("      mean caliper width; %.3f to %.3f mm by direction, twice the largest "
+                  "radius %.3f mm\n", r.D_min * 1e3, r.D_max * 1e3, r.D_radius * 1e3);
   }
   std::fflush(stdout);
   return conclude(path, s, frames);
@@ -712,7 +717,7 @@ int main(int argc, char** argv) {
   vtk->add_option("--every", vtk_every, "write every Nth frame (the final one always)")
       ->check(CLI::PositiveNumber)->capture_default_str();
 
-  auto* taylor = app.add_subcommand("taylor", "final length L and foot diameter D of a bar against a wall");
+  auto* taylor = app.add_subcommand("taylor", "final length L and foot diameter D (mean caliper width) of a bar against a wall");
   TaylorArgs ta;
   taylor->add_option("input", input, "stream, - for stdin")->capture_default_str();
   taylor->add_option("--body", ta.body, "body name (default: the first)");

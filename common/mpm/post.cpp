@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mpm/calipers.hpp"
 #include "mpm/error.hpp"
 #include "mpm/particles.hpp"
 
@@ -58,6 +59,11 @@ TaylorResult TaylorMeter::measure(const Frame& frame) const {
 
   // Axis: as given, else the longest extent of the body.
   r.axis = opt_.axis;
+  if (scene_.axisymmetric) {  // x is the radius: the bar's axis is the symmetry axis y
+    if (r.axis == 0)
+      throw InputError("--axis", "an axisymmetric scene's bar stands along y (x is the radius)");
+    r.axis = 1;
+  }
   if (r.axis < 0) {
     r.axis = 0;
     for (int a = 1; a < d; ++a)
@@ -80,6 +86,10 @@ TaylorResult TaylorMeter::measure(const Frame& frame) const {
   }
 
   double L = 0, R = 0;
+  std::vector<double> u, w;  // the particles' coordinates across the axis (3D)
+  const int a1 = (ax + 1) % 3, a2 = (ax + 2) % 3;
+  double lat_lo = 1e300, lat_hi = -1e300;  // 2D: the one coordinate across the axis
+  const int lat = d == 2 ? 1 - ax : -1;
   for (std::size_t i = 0; i < n; ++i) {
     if (body[i] != body_) continue;
     L = std::max(L, std::abs(x[i * d + ax] - r.wall));
@@ -87,9 +97,27 @@ TaylorResult TaylorMeter::measure(const Frame& frame) const {
     for (int a = 0; a < d; ++a)
       if (a != ax) r2 += (x[i * d + a] - centre[a]) * (x[i * d + a] - centre[a]);
     R = std::max(R, std::sqrt(r2));
+    if (d == 3) {
+      u.push_back(x[i * d + a1]);
+      w.push_back(x[i * d + a2]);
+    } else {
+      lat_lo = std::min(lat_lo, x[i * d + lat]);
+      lat_hi = std::max(lat_hi, x[i * d + lat]);
+    }
   }
-  r.L = L + (opt_.surface ? 0.5 * r.spacing : 0.0);
-  r.D = 2 * R + (opt_.surface ? r.spacing : 0.0);
+  const double add = opt_.surface ? r.spacing : 0.0;
+  r.L = L + 0.5 * add;
+  if (d == 3) {
+    const Calipers c = caliper_widths(u, w);
+    r.D = c.mean + add, r.D_min = c.min + add, r.D_max = c.max + add;
+    r.D_radius = 2 * R + add;
+  } else if (scene_.axisymmetric) {
+    // x is the radius: the foot is a disc whose diameter is twice its largest radius.
+    r.D = r.D_min = r.D_max = r.D_radius = 2 * std::max(std::abs(lat_lo), std::abs(lat_hi)) + add;
+  } else {
+    r.D = r.D_min = r.D_max = lat_hi - lat_lo + add;
+    r.D_radius = 2 * R + add;
+  }
   return r;
 }
 

@@ -20,6 +20,8 @@ struct TaylorOptions {
 struct TaylorResult {
   double time = 0;      ///< s, of the measured frame
   double L = 0, D = 0;  ///< final length and foot diameter, m
+  double D_min = 0, D_max = 0;  ///< narrowest and widest caliper width across the axis, m
+  double D_radius = 0;          ///< twice the largest distance from the axis, m (the old D)
   double L0 = 0, D0 = 0;///< the same measures on the first frame, m
   int axis = 2;
   double wall = 0;      ///< m
@@ -29,9 +31,13 @@ struct TaylorResult {
 };
 
 /// Measures a bar standing on a wall: L is the largest distance of a particle from the wall
-/// along the axis; D twice the largest distance of a particle from the bar's axis (through the
-/// mass centre of the particles in the plane across it). "surface" adds half a spacing to L
-/// and a whole spacing to D. Throws InputError when the body or the wall cannot be found.
+/// along the axis. D is the foot's diameter as calipers give it: in 3D the width of the
+/// particles' projection on the plane across the axis averaged over all directions (the
+/// hull's perimeter / pi), with the narrowest and widest widths beside it; in plane strain the
+/// width across the axis; in axisymmetry twice the largest radius. (A Cartesian grid leaves
+/// the foot slightly four-fold, so twice the largest distance from the axis, D_radius, is an
+/// upper bound set by one particle.) "surface" adds half a spacing to L and a whole spacing to
+/// the diameters. Throws InputError when the body or the wall cannot be found.
 class TaylorMeter {
  public:
   TaylorMeter(const Scene& scene, const TaylorOptions& options);

@@ -8,8 +8,8 @@ bin=$1; shift
 mkdir -p study
 table=study/table.md
 {
-  echo "| cell mm | particles | steps | L mm | D mm | L surf mm | D surf mm | L vs exp | D vs exp | seed MPM L, D mm | L vs seed | D vs seed | wall s | Mpart-steps/s |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "| cell mm | particles | steps | L mm | D mm | D by direction mm | 2 r_max mm | L surf mm | D surf mm | L vs exp | D vs exp | seed MPM L, D mm | L vs seed | D vs seed | wall s | Mpart-steps/s |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 } > "$table"
 for cell in "$@"; do
   out=study/taylor_${cell}.mpm
@@ -29,7 +29,8 @@ L, D = c["L"] * 1e3, c["D"] * 1e3
 Ls, Ds = s["L"] * 1e3, s["D"] * 1e3
 pct = lambda a, b: f"{100 * (a / b - 1):+.2f}%"
 seed_cols = f"{seed[0]}, {seed[1]} | {pct(L, seed[0])} | {pct(D, seed[1])}" if seed else "- | - | -"
-print(f"| {cell} | {c['particles']} | {steps} | {L:.3f} | {D:.3f} | {Ls:.3f} | {Ds:.3f} | {pct(L, 16.2)} | {pct(D, 13.5)} | {seed_cols} | {t1 - t0:.1f} | {rate} |")
+rng = f"{c['D_min'] * 1e3:.3f}-{c['D_max'] * 1e3:.3f}"
+print(f"| {cell} | {c['particles']} | {steps} | {L:.3f} | {D:.3f} | {rng} | {c['D_radius'] * 1e3:.3f} | {Ls:.3f} | {Ds:.3f} | {pct(L, 16.2)} | {pct(D, 13.5)} | {seed_cols} | {t1 - t0:.1f} | {rate} |")
 PY
   echo "cell $cell mm done" >&2
 done
@@ -37,4 +38,6 @@ echo
 cat "$table"
 echo
 echo "Experiment (Johnson & Holmquist 1988): L = 16.2 mm, D = 13.5 mm. L and D on particle centres;"
+echo "D is the mean caliper width of the foot (hull perimeter / pi), with the narrowest and widest"
+echo "widths by direction and twice the largest radius beside it;"
 echo "'surf' adds half a particle spacing at the free end and at each side of the foot."

@@ -34,9 +34,13 @@ TEST(Regression, TaylorBarCoarse) {
   ASSERT_EQ(r.status, 0) << r.err;
   r = run(post + " taylor " + out.string() + " --json", dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  const double L_run = json_value(r.out, "L"), D_run = json_value(r.out, "D");
+  const double L_run = json_value(r.out, "L"), D_run = json_value(r.out, "D_radius");
   EXPECT_NEAR(L_run, L, tol * L) << r.out;
   EXPECT_NEAR(D_run, D, tol * D) << r.out;
+  const double D_mean = json_value(r.out, "D");
+  EXPECT_LE(json_value(r.out, "D_min"), D_mean) << r.out;
+  EXPECT_LE(D_mean, json_value(r.out, "D_max")) << r.out;
+  EXPECT_LE(json_value(r.out, "D_max"), D_run * (1 + 1e-12)) << r.out;
   EXPECT_EQ(std::size_t(json_value(r.out, "particles")), std::size_t(ref["particles"].value_or(0)));
   // The bar came to rest: the last history row's kinetic energy is a small part of the first's.
   r = run(post + " history " + out.string() + " --columns time,kinetic,leapfrog_total", dir);
