@@ -9,12 +9,33 @@
 namespace mpm {
 
 template <int D>
-UniformGrid<D>::UniformGrid(const Lattice& lattice, const BoundarySpec& boundary)
-    : lattice_(lattice), boundary_(boundary), h_(lattice.h), inv_h_(1.0 / lattice.h) {
+CellLattice<D>::CellLattice(const Lattice& lattice) : h_(lattice.h), inv_h_(1.0 / lattice.h) {
   if (lattice.dim != D) throw std::logic_error("lattice dimension does not match the solver");
   for (int a = 0; a < D; ++a) {
     origin_[a] = lattice.origin[a];
     cells_[a] = lattice.cells[a];
+  }
+}
+
+template <int D>
+int CellLattice<D>::particle_box(const Vec<D>* x, std::size_t n, int margin, IVec<D>& lo,
+                                 IVec<D>& hi) const {
+  IVec<D> plo, phi;  // the particles' cells
+  cell_bounds<D>(x, n, origin_, inv_h_, cells_, plo, phi);
+  for (int a = 0; a < D; ++a) {
+    lo[a] = std::max(0, plo[a] - margin);
+    hi[a] = std::min(cells_[a] - 1, phi[a] + margin);
+  }
+  int slab = D - 1;
+  for (int a = D - 2; a >= 0; --a)
+    if (hi[a] - lo[a] > hi[slab] - lo[slab]) slab = a;
+  return slab;
+}
+
+template <int D>
+UniformGrid<D>::UniformGrid(const Lattice& lattice, const BoundarySpec& boundary)
+    : Base(lattice), lattice_(lattice), boundary_(boundary) {
+  for (int a = 0; a < D; ++a) {
     lo_[a] = 0;
     hi_[a] = cells_[a] - 1;
   }
@@ -22,18 +43,10 @@ UniformGrid<D>::UniformGrid(const Lattice& lattice, const BoundarySpec& boundary
 
 template <int D>
 void UniformGrid<D>::fit(const Vec<D>* x, std::size_t n, int margin) {
-  IVec<D> lo, hi;  // the particles' cells
-  cell_bounds<D>(x, n, origin_, inv_h_, cells_, lo, hi);
-  for (int a = 0; a < D; ++a) {
-    lo_[a] = std::max(0, lo[a] - margin);
-    hi_[a] = std::min(cells_[a] - 1, hi[a] + margin);
-    nodes_[a] = hi_[a] - lo_[a] + 2;
-  }
   // Slab axis: the longest extent (ties go to the highest axis). It is the slowest index of
   // the node layout and of the particle order, so a slab of layers is a contiguous range.
-  slab_ = D - 1;
-  for (int a = D - 2; a >= 0; --a)
-    if (nodes_[a] > nodes_[slab_]) slab_ = a;
+  slab_ = this->particle_box(x, n, margin, lo_, hi_);
+  for (int a = 0; a < D; ++a) nodes_[a] = hi_[a] - lo_[a] + 2;
   std::int64_t s = 1;
   for (int a = 0; a < D; ++a)
     if (a != slab_) stride_[a] = s, s *= nodes_[a];
@@ -89,27 +102,8 @@ IVec<D> UniformGrid<D>::global_node(std::int64_t index) const {
   return k;
 }
 
-template <int D>
-void UniformGrid<D>::clear(bool remap, bool rigid_bodies) {
-  const std::int64_t n = std::int64_t(m.size());
-  const bool full = !clean_ || (remap && v_remap.size() != m.size());
-  if (remap && v_remap.size() != m.size()) v_remap.resize(m.size());
-  if (rigid_bodies && rigid.size() != m.size()) rigid.resize(m.size());
-  // A node without mass holds no momentum, force or remapped momentum (the grid kernels keep it
-  // so), so only the nodes that carried mass need clearing: empty nodes cost one read.
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
-    if (full || m[i] != 0) {
-      m[i] = 0;
-      v[i].setZero();
-      a[i].setZero();
-      if (remap) v_remap[i].setZero();
-    }
-    if (rigid_bodies) rigid[i] = 0;
-  }
-  clean_ = true;
-}
-
+template class CellLattice<2>;
+template class CellLattice<3>;
 template class UniformGrid<2>;
 template class UniformGrid<3>;
 

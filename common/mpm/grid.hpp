@@ -46,6 +46,75 @@ void cell_bounds(const Vec<D>* x, std::size_t n, const Vec<D>& origin, double in
   if (n == 0) lo.setZero(), hi.setZero();
 }
 
+/// Clears the node arrays m, v and a (v_remap when `remap`, rigid when `rigid_bodies`, sizing
+/// those two to m). A node without mass holds no momentum, force or remapped momentum (the
+/// grid kernels keep it so), so once `clean` only the nodes that carried mass are cleared:
+/// empty nodes cost one read. A grid sets `clean` false when its arrays change meaning.
+template <int D>
+void clear_nodes(std::vector<double>& m, std::vector<Vec<D>>& v, std::vector<Vec<D>>& a,
+                 std::vector<Vec<D>>& v_remap, std::vector<std::uint8_t>& rigid, bool& clean,
+                 bool remap, bool rigid_bodies) {
+  const std::int64_t n = std::int64_t(m.size());
+  const bool full = !clean || (remap && v_remap.size() != m.size());
+  if (remap && v_remap.size() != m.size()) v_remap.resize(m.size());
+  if (rigid_bodies && rigid.size() != m.size()) rigid.resize(m.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) {
+    if (full || m[i] != 0) {
+      m[i] = 0;
+      v[i].setZero();
+      a[i].setZero();
+      if (remap) v_remap[i].setZero();
+    }
+    if (rigid_bodies) rigid[i] = 0;
+  }
+  clean = true;
+}
+
+/// The lattice geometry the uniform grids share: cubic (square) cells of side h counted from the
+/// domain's origin, the domain's cell counts, where a point lies, and the box of cells a set
+/// of particles needs.
+template <int D>
+class CellLattice {
+ public:
+  explicit CellLattice(const Lattice& lattice);
+
+  double h() const { return h_; }
+  double inv_h() const { return inv_h_; }
+  const Vec<D>& origin() const { return origin_; }
+  /// Global cell of a position and the position within it (fractions of h in [0,1)).
+  void locate(const Vec<D>& x, IVec<D>& cell, Vec<D>& xi) const {
+    const Vec<D> r = (x - origin_) * inv_h_;
+    for (int a = 0; a < D; ++a) {
+      const double f = std::floor(r[a]);
+      cell[a] = int(f);
+      xi[a] = r[a] - f;
+    }
+  }
+  /// True when a global cell lies inside the domain.
+  bool in_domain(const IVec<D>& cell) const {
+    for (int a = 0; a < D; ++a)
+      if (cell[a] < 0 || cell[a] >= cells_[a]) return false;
+    return true;
+  }
+  double cell_size(std::int64_t) const { return h_; }
+  double min_cell_size() const { return h_; }
+  /// Shape functions and gradients (1/m) at local coordinates xi of a cell.
+  void shape(std::int64_t, const Vec<D>& xi, double* N, Vec<D>* G) const {
+    shape_functions<D>(xi, inv_h_, N, G);
+  }
+  void values(std::int64_t, const Vec<D>& xi, double* N) const { shape_values<D>(xi, N); }
+
+ protected:
+  /// The cells [lo, hi] of n particles widened by `margin` cells, clamped to the domain; returns
+  /// the slab axis, the longest extent (ties go to the highest axis).
+  int particle_box(const Vec<D>* x, std::size_t n, int margin, IVec<D>& lo, IVec<D>& hi) const;
+
+  Vec<D> origin_;
+  double h_, inv_h_;
+  IVec<D> cells_;  ///< domain cells per axis
+};
+
 // What the kernels need of a grid (UniformGrid here; a graded grid provides the same):
 //   static constexpr int kMaxNodes;     nodes of a cell, at most
 //   static constexpr bool kFixedNodes;  every cell has kMaxNodes nodes
@@ -62,8 +131,15 @@ void cell_bounds(const Vec<D>* x, std::size_t n, const Vec<D>& origin, double in
 //   fixed_nodes(), slip_nodes();                      nodes on constrained domain faces
 
 template <int D>
-class UniformGrid {
+class UniformGrid : public CellLattice<D> {
+  using Base = CellLattice<D>;
+  using Base::cells_;
+  using Base::h_;
+  using Base::inv_h_;
+  using Base::origin_;
+
  public:
+  using Base::locate;
   static constexpr int kDim = D;
   static constexpr int kMaxNodes = kCorners<D>;
   static constexpr bool kFixedNodes = true;
@@ -76,26 +152,8 @@ class UniformGrid {
   /// arrays. Particles must be inside the domain.
   void fit(const Vec<D>* x, std::size_t n, int margin = 1);
 
-  // Geometry -------------------------------------------------------------------------------
-  double h() const { return h_; }
-  double inv_h() const { return inv_h_; }
-  const Vec<D>& origin() const { return origin_; }
+  // Geometry (locate, in_domain, shape, values, cell sizes: CellLattice) -------------------
   const Lattice& lattice() const { return lattice_; }
-  /// Global cell of a position and the position within it (fractions of h in [0,1)).
-  void locate(const Vec<D>& x, IVec<D>& cell, Vec<D>& xi) const {
-    const Vec<D> r = (x - origin_) * inv_h_;
-    for (int a = 0; a < D; ++a) {
-      const double f = std::floor(r[a]);
-      cell[a] = int(f);
-      xi[a] = r[a] - f;
-    }
-  }
-  /// True when a global cell lies inside the domain.
-  bool in_domain(const IVec<D>& cell) const {
-    for (int a = 0; a < D; ++a)
-      if (cell[a] < 0 || cell[a] >= cells_[a]) return false;
-    return true;
-  }
   /// Cell key and local coordinates of a point known to be inside the window.
   void locate(const Vec<D>& x, std::int64_t& key, Vec<D>& xi) const {
     IVec<D> cell;
@@ -106,7 +164,7 @@ class UniformGrid {
   Where where(const Vec<D>& x, std::int64_t& key, Vec<D>& xi) const {
     IVec<D> cell;
     locate(x, cell, xi);
-    if (!in_domain(cell)) return Where::OutsideDomain;
+    if (!this->in_domain(cell)) return Where::OutsideDomain;
     if (!in_window(cell)) return Where::OutsideWindow;
     key = this->key(cell);
     return Where::Window;
@@ -116,14 +174,7 @@ class UniformGrid {
     for (int c = 0; c < kMaxNodes; ++c) nodes[c] = key + corner_[c];
     return kMaxNodes;
   }
-  /// Shape functions and gradients (1/m) at local coordinates xi of a cell.
-  void shape(std::int64_t, const Vec<D>& xi, double* N, Vec<D>* G) const {
-    shape_functions<D>(xi, inv_h_, N, G);
-  }
-  void values(std::int64_t, const Vec<D>& xi, double* N) const { shape_values<D>(xi, N); }
   std::size_t key_count() const { return m.size(); }
-  double cell_size(std::int64_t) const { return h_; }
-  double min_cell_size() const { return h_; }
   /// True when a global cell lies inside the window.
   bool in_window(const IVec<D>& cell) const {
     for (int a = 0; a < D; ++a)
@@ -161,7 +212,9 @@ class UniformGrid {
   /// Clears m, v and a (and v_remap when `remap`, rigid when `rigid_bodies`) over the window.
   /// After the first clear following fit(), only nodes with mass are cleared: users must keep
   /// v, a and v_remap zero at nodes without mass (the solver's grid kernels do).
-  void clear(bool remap, bool rigid_bodies = false);
+  void clear(bool remap, bool rigid_bodies = false) {
+    clear_nodes<D>(m, v, a, v_remap, rigid, clean_, remap, rigid_bodies);
+  }
 
   // Boundary conditions --------------------------------------------------------------------
   /// A window node on a constrained face; face = 2 * axis + (0 for min, 1 for max).
@@ -178,9 +231,6 @@ class UniformGrid {
  private:
   Lattice lattice_;
   BoundarySpec boundary_;
-  Vec<D> origin_;
-  double h_, inv_h_;
-  IVec<D> cells_;          ///< domain cells per axis
   IVec<D> lo_, hi_;        ///< window cells (inclusive)
   IVec<D> nodes_;          ///< window nodes per axis
   std::array<std::int64_t, D> stride_{};

@@ -14,6 +14,7 @@
 #include "mpm/lattice.hpp"
 #include "mpm/materials/material.hpp"
 #include "mpm/particles.hpp"
+#include "mpm/sparse_grid.hpp"
 #include "mpm/stream.hpp"
 #include "mpm/version.hpp"
 #include "mpm/voxelise.hpp"
@@ -39,6 +40,16 @@ std::string with_explicit_domain(const std::string& text, const Lattice& lat) {
   std::ostringstream o;
   o << doc;
   return o.str() + "\n";
+}
+
+/// Bytes of the sparse grid at the start: its nodes (8 + 3 D 8 bytes), the cell-to-key table
+/// of its box (4 bytes a cell) and each active cell's node list and layer.
+template <int D>
+double sparse_grid_bytes(const Scene& scene, const Lattice& lattice, const ColumnStore& cols) {
+  SparseGrid<D> g(lattice, scene.boundary);
+  g.fit(cols.get<Vec<D>>(col::x), cols.size());
+  return double(g.nodes()) * (8 + 3 * D * 8) + double(g.box_cells()) * 4 +
+         double(g.key_count()) * 4 * (kCorners<D> + 1);
 }
 
 std::string mm(double x) {
@@ -93,7 +104,9 @@ int prepare_model(const PrepOptions& opt) {
   double nodes = 1;
   for (int a = 0; a < d; ++a) nodes *= std::floor((hi[a] - lo[a]) / lattice.h) + 4;
   if (graded) nodes = double(graded->nodes);  // the graded grid has no window
-  const double bytes_grid = nodes * (8 + 3 * d * 8);
+  double bytes_grid = nodes * (8 + 3 * d * 8);
+  if (scene.grid.sparse)
+    bytes_grid = d == 3 ? sparse_grid_bytes<3>(scene, lattice, cols) : sparse_grid_bytes<2>(scene, lattice, cols);
 
   if (!opt.quiet) {
     std::fprintf(stderr, "mpm-prep: %s%s%s (%dD%s)\n", scene.source.c_str(),
@@ -139,8 +152,9 @@ int prepare_model(const PrepOptions& opt) {
                  dt * 1e9, scene.solver.cfl, speed, steps, scene.solver.end_time * 1e6);
     std::fprintf(stderr,
                  "  memory of a run: about %.0f bytes a particle, %.1f MB for particles and %.1f "
-                 "MB for the grid window; %.3g million particle-steps\n",
+                 "MB for the grid %s; %.3g million particle-steps\n",
                  bytes_particle, bytes_particle * double(total) / 1e6, bytes_grid / 1e6,
+                 scene.grid.sparse ? "(sparse, at the start)" : "window",
                  double(total) * steps / 1e6);
     if (scene.solver.cfl > 1.0)
       std::fprintf(stderr, "  warning: solver.cfl = %g exceeds 1; explicit MPM is then unstable\n",

@@ -12,6 +12,7 @@
 #include "mpm/error.hpp"
 #include "mpm/explicit_solver.hpp"
 #include "mpm/graded_solver.hpp"
+#include "mpm/sparse_solver.hpp"
 #include "mpm/implicit/implicit_solver.hpp"
 #include "mpm/lattice.hpp"
 #include "mpm/stream.hpp"
@@ -339,6 +340,9 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
     if (graded)
       throw InputError("grid.levels", "the implicit solver runs on a uniform grid; remove the "
                                       "[[grid.levels]] boxes or use solver.type = \"explicit\"");
+    if (scene.grid.sparse)
+      throw InputError("grid.sparse", "the implicit solver runs on the dense grid; remove "
+                                      "grid.sparse or use solver.type = \"explicit\"");
     ImplicitSolver<UniformGrid<D>> solver(scene, UniformGrid<D>(lattice, scene.boundary),
                                           model.columns);
     return run_solver(opt, scene, lattice, solver);
@@ -354,6 +358,15 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
                                      "[[grid.levels]] (use colored, lr-slabs or array-expansion)");
     ExplicitSolver<GradedGrid<D>> solver(scene, GradedGrid<D>(lattice, scene), model.columns,
                                          strategy);
+    return run_solver(opt, scene, lattice, solver);
+  }
+  if (scene.grid.sparse) {
+    if (strategy == ScatterStrategy::Patch)
+      throw InputError("--strategy", "the patch strategy cuts the dense window into slabs of "
+                                     "nodes; with grid.sparse use colored, lr-slabs or "
+                                     "array-expansion");
+    ExplicitSolver<SparseGrid<D>> solver(scene, SparseGrid<D>(lattice, scene.boundary),
+                                         model.columns, strategy);
     return run_solver(opt, scene, lattice, solver);
   }
   UniformSolver<D> solver(scene, UniformGrid<D>(lattice, scene.boundary), model.columns, strategy);

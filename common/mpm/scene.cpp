@@ -889,7 +889,10 @@ void read_grid(Reader& r, Scene& s) {
   } else {
     g.padding = r.quantity("padding", dim::length, Bound::NonNegative).value_or(2 * g.cell_size);
   }
+  g.sparse = r.boolean("sparse").value_or(false);
   read_levels(r, s);
+  if (g.sparse && !g.levels.empty())
+    r.fail("sparse", "a graded grid ([[grid.levels]]) keeps its own node list; use one or the other");
   r.finish();
 }
 
@@ -1075,7 +1078,7 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
 
   {
     Reader g =
-        top.required_table("grid", {"cell_size", "domain", "padding", "levels"},
+        top.required_table("grid", {"cell_size", "domain", "padding", "sparse", "levels"},
                            "cell_size is required");
     read_grid(g, s);
   }

@@ -122,6 +122,10 @@ struct GridSpec {
   Vec3 domain_max = Vec3::Zero();
   double padding = 0;          ///< m, added around the bodies when the domain is fitted
   std::vector<LevelSpec> levels;  ///< refined boxes of a graded grid; empty: a uniform grid
+  /// Nodes only around the occupied cells (sparse_grid.hpp) instead of the dense window over
+  /// the particles' bounding box: for material that spreads (debris clouds). Explicit solver,
+  /// uniform grid.
+  bool sparse = false;
   SourceLoc loc;
   /// Number of levels: 1 + the highest refinement (1 for a uniform grid).
   int level_count() const {

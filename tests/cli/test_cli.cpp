@@ -176,6 +176,37 @@ TEST(Cli, UnstableRunStopsAndKeepsItsFrames) {
   EXPECT_EQ(r.status, 3);  // the run's failure propagates to scripts
 }
 
+// grid.sparse: the block runs on it and lands as on the dense window (the same frames, bit
+// for bit: it re-sorts at the same steps); what it cannot do is refused with the key named.
+TEST(Cli, SparseGridRunsAndRefusesWhatItCannotDo) {
+  const auto dir = temp_dir("sparse");
+  ASSERT_EQ(run(prep + " " + kBlock.string() + " -o " + (dir / "m.mpm").string(), dir).status, 0);
+  const std::string model = (dir / "m.mpm").string();
+  Result r = run(runner + " " + model + " --progress none -o " + (dir / "dense.mpm").string(), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run(runner + " " + model + " --progress none --set grid.sparse=true -o " + (dir / "sparse.mpm").string(), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run(post + " particles " + (dir / "dense.mpm").string() + " --columns x,v,sigma", dir);
+  Result q = run(post + " particles " + (dir / "sparse.mpm").string() + " --columns x,v,sigma", dir);
+  ASSERT_EQ(r.status, 0);
+  EXPECT_EQ(r.out, q.out);
+  const auto refused = [&](const std::string& args, const std::string& frag) {
+    Result e = run(runner + " " + model + " --progress none -o /dev/null " + args, dir);
+    EXPECT_EQ(e.status, 2) << args << "\n" << e.err;
+    EXPECT_NE(e.err.find(frag), std::string::npos) << args << ": " << e.err;
+  };
+  refused("--set grid.sparse=yes", "grid.sparse");
+  refused("--set grid.sparse=true --set solver.type=implicit", "grid.sparse");
+  refused("--set grid.sparse=true --strategy patch", "patch");
+  const fs::path graded = variant(dir, "sparse_levels.toml", "[boundary]",
+                                  "sparse = true\n\n[[grid.levels]]\nlevel = 2\nmin = \"-2 -2 0 mm\"\n"
+                                  "max = \"2 2 4 mm\"\n\n[boundary]");
+  r = run(prep + " " + graded.string() + " -o /dev/null", dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("sparse_levels.toml:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("sparse"), std::string::npos) << r.err;
+}
+
 // A scene whose step count is absurd (a density typed in the wrong unit) gets a warning from
 // mpm-prep before anyone waits for the run; the base scene gets none.
 TEST(Cli, PrepWarnsOfAnAbsurdStepCount) {
