@@ -34,7 +34,7 @@ int CellLattice<D>::particle_box(const Vec<D>* x, std::size_t n, int margin, IVe
 
 template <int D>
 UniformGrid<D>::UniformGrid(const Lattice& lattice, const BoundarySpec& boundary)
-    : Base(lattice), lattice_(lattice), boundary_(boundary) {
+    : Base(lattice), GridNodes<D>(boundary), lattice_(lattice) {
   for (int a = 0; a < D; ++a) {
     lo_[a] = 0;
     hi_[a] = cells_[a] - 1;
@@ -61,38 +61,13 @@ void UniformGrid<D>::fit(const Vec<D>* x, std::size_t n, int margin) {
       if ((c >> a) & 1) off += stride_[a];
     corner_[c] = off;
   }
-  clean_ = false;  // the arrays now mean other nodes: clear them all next time
-  m.resize(s);
-  v.resize(s);
-  a.resize(s);
-  if (!v_remap.empty()) v_remap.resize(s);
-  if (!rigid.empty()) rigid.resize(s);
-
+  this->resize_nodes(std::size_t(s));  // the arrays now mean other nodes
   // Nodes on constrained domain faces that the window reaches.
-  fixed_.clear();
-  slip_.clear();
-  for (int face = 0; face < 2 * D; ++face) {
-    const BoundaryType type = boundary_.face[face];
-    if (type == BoundaryType::Free) continue;
-    const int axis = face / 2;
-    const int plane = (face % 2 == 0) ? 0 : cells_[axis];  // global node index of the face
-    const int local = plane - lo_[axis];
-    if (local < 0 || local >= nodes_[axis]) continue;
-    // Enumerate the window's nodes in that plane.
-    IVec<D> k = IVec<D>::Zero();
-    k[axis] = local;
-    const int other0 = axis == 0 ? 1 : 0;
-    const int other1 = D == 3 ? (axis == 2 ? 1 : 2) : -1;
-    const int n0 = nodes_[other0], n1 = other1 >= 0 ? nodes_[other1] : 1;
-    for (int j = 0; j < n1; ++j)
-      for (int i = 0; i < n0; ++i) {
-        k[other0] = i;
-        if (other1 >= 0) k[other1] = j;
-        std::int64_t idx = 0;
-        for (int b = 0; b < D; ++b) idx += std::int64_t(k[b]) * stride_[b];
-        (type == BoundaryType::Fixed ? fixed_ : slip_).push_back({idx, face});
-      }
-  }
+  this->collect_face_nodes(cells_, lo_, nodes_, [&](const IVec<D>& k) {
+    std::int64_t idx = 0;
+    for (int b = 0; b < D; ++b) idx += std::int64_t(k[b]) * stride_[b];
+    return idx;
+  });
 }
 
 template <int D>

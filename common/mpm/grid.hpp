@@ -46,30 +46,100 @@ void cell_bounds(const Vec<D>* x, std::size_t n, const Vec<D>& origin, double in
   if (n == 0) lo.setZero(), hi.setZero();
 }
 
-/// Clears the node arrays m, v and a (v_remap when `remap`, rigid when `rigid_bodies`, sizing
-/// those two to m). A node without mass holds no momentum, force or remapped momentum (the
-/// grid kernels keep it so), so once `clean` only the nodes that carried mass are cleared:
-/// empty nodes cost one read. A grid sets `clean` false when its arrays change meaning.
+/// The node data every uniform grid holds (structure of arrays) and its constrained nodes.
+/// Scatter kernels accumulate momentum into v, force into a and remapped momentum into
+/// v_remap; the grid kernels then divide by the mass, so after them these hold velocity (m/s)
+/// and acceleration (m/s^2).
 template <int D>
-void clear_nodes(std::vector<double>& m, std::vector<Vec<D>>& v, std::vector<Vec<D>>& a,
-                 std::vector<Vec<D>>& v_remap, std::vector<std::uint8_t>& rigid, bool& clean,
-                 bool remap, bool rigid_bodies) {
-  const std::int64_t n = std::int64_t(m.size());
-  const bool full = !clean || (remap && v_remap.size() != m.size());
-  if (remap && v_remap.size() != m.size()) v_remap.resize(m.size());
-  if (rigid_bodies && rigid.size() != m.size()) rigid.resize(m.size());
+class GridNodes {
+ public:
+  explicit GridNodes(const BoundarySpec& boundary) : boundary_(boundary) {}
+
+  std::vector<double> m;        ///< nodal mass, kg
+  std::vector<Vec<D>> v;        ///< momentum, then velocity
+  std::vector<Vec<D>> a;        ///< force, then acceleration
+  std::vector<Vec<D>> v_remap;  ///< MUSL: remapped momentum, then velocity
+  std::vector<std::uint8_t> rigid;  ///< 1 + index of the rigid body touching the node, or 0
+  std::size_t nodes() const { return m.size(); }
+
+  /// Clears m, v and a (v_remap when `remap`, rigid when `rigid_bodies`, sizing those two to
+  /// m). A node without mass holds no momentum, force or remapped momentum (the grid kernels
+  /// keep it so), so after the first clear following a refit only the nodes that carried mass
+  /// are cleared: empty nodes cost one read.
+  void clear(bool remap, bool rigid_bodies = false) {
+    const std::int64_t n = std::int64_t(m.size());
+    const bool full = !clean_ || (remap && v_remap.size() != m.size());
+    if (remap && v_remap.size() != m.size()) v_remap.resize(m.size());
+    if (rigid_bodies && rigid.size() != m.size()) rigid.resize(m.size());
 #pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
-    if (full || m[i] != 0) {
-      m[i] = 0;
-      v[i].setZero();
-      a[i].setZero();
-      if (remap) v_remap[i].setZero();
+    for (std::int64_t i = 0; i < n; ++i) {
+      if (full || m[i] != 0) {
+        m[i] = 0;
+        v[i].setZero();
+        a[i].setZero();
+        if (remap) v_remap[i].setZero();
+      }
+      if (rigid_bodies) rigid[i] = 0;
     }
-    if (rigid_bodies) rigid[i] = 0;
+    clean_ = true;
   }
-  clean = true;
-}
+
+  /// A node on a constrained domain face; face = 2 * axis + (0 for min, 1 for max).
+  struct FaceNode {
+    std::int64_t node;
+    int face;
+  };
+  /// Nodes on fixed faces (every velocity component held at zero).
+  const std::vector<FaceNode>& fixed_nodes() const { return fixed_; }
+  /// Nodes on slip faces (the normal component held at zero).
+  const std::vector<FaceNode>& slip_nodes() const { return slip_; }
+  const BoundarySpec& boundary() const { return boundary_; }
+
+ protected:
+  /// Sizes the node arrays to n nodes whose meaning has changed (the next clear is full).
+  void resize_nodes(std::size_t n) {
+    clean_ = false;
+    m.resize(n);
+    v.resize(n);
+    a.resize(n);
+    if (!v_remap.empty()) v_remap.resize(n);
+    if (!rigid.empty()) rigid.resize(n);
+  }
+  /// Lists the nodes on constrained domain faces (a domain of `cells`) among the nodes of the
+  /// box whose lowest node is the global node `lo` and which has `count` nodes along each axis;
+  /// index(k) gives the node of the box's local node k, or -1 when there is none. Faces in
+  /// order, then the other axes' nodes with the lower axis fastest.
+  template <class Index>
+  void collect_face_nodes(const IVec<D>& cells, const IVec<D>& lo, const IVec<D>& count, Index&& index) {
+    fixed_.clear();
+    slip_.clear();
+    for (int face = 0; face < 2 * D; ++face) {
+      const BoundaryType type = boundary_.face[face];
+      if (type == BoundaryType::Free) continue;
+      const int axis = face / 2;
+      const int local = ((face % 2 == 0) ? 0 : cells[axis]) - lo[axis];
+      if (local < 0 || local >= count[axis]) continue;
+      IVec<D> k = IVec<D>::Zero();
+      k[axis] = local;
+      const int other0 = axis == 0 ? 1 : 0;
+      const int other1 = D == 3 ? (axis == 2 ? 1 : 2) : -1;
+      const int n0 = count[other0], n1 = other1 >= 0 ? count[other1] : 1;
+      for (int j = 0; j < n1; ++j)
+        for (int i = 0; i < n0; ++i) {
+          k[other0] = i;
+          if (other1 >= 0) k[other1] = j;
+          const std::int64_t node = index(k);
+          if (node >= 0) (type == BoundaryType::Fixed ? fixed_ : slip_).push_back({node, face});
+        }
+    }
+  }
+
+  BoundarySpec boundary_;
+  bool clean_ = false;  ///< nodes without mass hold zeros everywhere
+
+ private:
+  std::vector<FaceNode> fixed_, slip_;
+};
 
 /// The lattice geometry the uniform grids share: cubic (square) cells of side h counted from the
 /// domain's origin, the domain's cell counts, where a point lies, and the box of cells a set
@@ -131,15 +201,13 @@ class CellLattice {
 //   fixed_nodes(), slip_nodes();                      nodes on constrained domain faces
 
 template <int D>
-class UniformGrid : public CellLattice<D> {
+class UniformGrid : public CellLattice<D>, public GridNodes<D> {
   using Base = CellLattice<D>;
   using Base::cells_;
-  using Base::h_;
-  using Base::inv_h_;
-  using Base::origin_;
 
  public:
   using Base::locate;
+  using GridNodes<D>::m;
   static constexpr int kDim = D;
   static constexpr int kMaxNodes = kCorners<D>;
   static constexpr bool kFixedNodes = true;
@@ -196,48 +264,18 @@ class UniformGrid : public CellLattice<D> {
   int slab_axis() const { return slab_; }
   /// Offset of corner c of a cell from its lower corner node.
   std::int64_t corner(int c) const { return corner_[c]; }
-  std::size_t nodes() const { return m.size(); }
   /// Global node index (lattice numbering) of a window node.
   IVec<D> global_node(std::int64_t index) const;
 
-  // Node data (structure of arrays) ---------------------------------------------------------
-  // Scatter kernels accumulate momentum into v, force into a and remapped momentum into
-  // v_remap; the grid kernels then divide by the mass, so after them these hold velocity
-  // (m/s) and acceleration (m/s^2).
-  std::vector<double> m;        ///< nodal mass, kg
-  std::vector<Vec<D>> v;        ///< momentum, then velocity
-  std::vector<Vec<D>> a;        ///< force, then acceleration
-  std::vector<Vec<D>> v_remap;  ///< MUSL: remapped momentum, then velocity
-  std::vector<std::uint8_t> rigid;  ///< 1 + index of the rigid body touching the node, or 0
-  /// Clears m, v and a (and v_remap when `remap`, rigid when `rigid_bodies`) over the window.
-  /// After the first clear following fit(), only nodes with mass are cleared: users must keep
-  /// v, a and v_remap zero at nodes without mass (the solver's grid kernels do).
-  void clear(bool remap, bool rigid_bodies = false) {
-    clear_nodes<D>(m, v, a, v_remap, rigid, clean_, remap, rigid_bodies);
-  }
-
-  // Boundary conditions --------------------------------------------------------------------
-  /// A window node on a constrained face; face = 2 * axis + (0 for min, 1 for max).
-  struct FaceNode {
-    std::int64_t node;
-    int face;
-  };
-  /// Nodes on fixed faces (every velocity component held at zero).
-  const std::vector<FaceNode>& fixed_nodes() const { return fixed_; }
-  /// Nodes on slip faces (the normal component held at zero).
-  const std::vector<FaceNode>& slip_nodes() const { return slip_; }
-  const BoundarySpec& boundary() const { return boundary_; }
+  // Node data and constrained nodes: GridNodes.
 
  private:
   Lattice lattice_;
-  BoundarySpec boundary_;
   IVec<D> lo_, hi_;        ///< window cells (inclusive)
   IVec<D> nodes_;          ///< window nodes per axis
   std::array<std::int64_t, D> stride_{};
   std::array<std::int64_t, kCorners<D>> corner_{};
   int slab_ = D - 1;
-  bool clean_ = false;  ///< nodes without mass hold zeros everywhere
-  std::vector<FaceNode> fixed_, slip_;
 };
 
 }  // namespace mpm

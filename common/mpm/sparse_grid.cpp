@@ -13,7 +13,7 @@ namespace mpm {
 
 template <int D>
 SparseGrid<D>::SparseGrid(const Lattice& lattice, const BoundarySpec& boundary)
-    : Base(lattice), boundary_(boundary) {
+    : Base(lattice), GridNodes<D>(boundary) {
   for (int a = 0; a < D; ++a) lo_[a] = 0, hi_[a] = -1;
 }
 
@@ -154,34 +154,17 @@ void SparseGrid<D>::fit(const Vec<D>* x, std::size_t n, int margin) {
         cell_layer_[std::size_t(key)] = D == 3 ? c2 : c1;  // the slab axis is the slowest
       }
 
-  clean_ = false;
-  m.resize(count);
-  v.resize(count);
-  a.resize(count);
-  if (!v_remap.empty()) v_remap.resize(count);
-  if (!rigid.empty()) rigid.resize(count);
-
+  this->resize_nodes(count);
   // Active nodes on constrained domain faces, in the dense window's order.
   std::array<std::size_t, D> nstride{};
+  IVec<D> nodes_per_axis;
   for (int q = 0; q < D; ++q) nstride[order[q]] = nb.stride[q];
-  fixed_.clear();
-  slip_.clear();
-  for (int face = 0; face < 2 * D; ++face) {
-    const BoundaryType type = boundary_.face[face];
-    if (type == BoundaryType::Free) continue;
-    const int axis = face / 2;
-    const int local = ((face % 2 == 0) ? 0 : cells_[axis]) - lo_[axis];
-    if (local < 0 || local > ext[axis]) continue;
-    const int other0 = axis == 0 ? 1 : 0;
-    const int other1 = D == 3 ? (axis == 2 ? 1 : 2) : -1;
-    const int n0 = ext[other0] + 1, n1 = other1 >= 0 ? ext[other1] + 1 : 1;
-    for (int j = 0; j < n1; ++j)
-      for (int i = 0; i < n0; ++i) {
-        std::size_t idx = std::size_t(local) * nstride[axis] + std::size_t(i) * nstride[other0];
-        if (other1 >= 0) idx += std::size_t(j) * nstride[other1];
-        if (node_id[idx] >= 0) (type == BoundaryType::Fixed ? fixed_ : slip_).push_back({node_id[idx], face});
-      }
-  }
+  for (int a = 0; a < D; ++a) nodes_per_axis[a] = ext[a] + 1;
+  this->collect_face_nodes(cells_, lo_, nodes_per_axis, [&](const IVec<D>& k) {
+    std::size_t idx = 0;
+    for (int a = 0; a < D; ++a) idx += std::size_t(k[a]) * nstride[a];
+    return std::int64_t(node_id[idx]);
+  });
 }
 
 template class SparseGrid<2>;

@@ -19,7 +19,7 @@
 namespace mpm {
 
 template <int D>
-class SparseGrid : public CellLattice<D> {
+class SparseGrid : public CellLattice<D>, public GridNodes<D> {
   using Base = CellLattice<D>;
   using Base::cells_;
 
@@ -62,25 +62,10 @@ class SparseGrid : public CellLattice<D> {
   int layer(std::int64_t key) const { return cell_layer_[std::size_t(key)]; }
   int layers() const { return hi_[slab_] - lo_[slab_] + 1; }
   int slab_axis() const { return slab_; }
-  std::size_t nodes() const { return m.size(); }
   /// Cells in the box the active cells lie in (the cell-to-key table's length).
   std::size_t box_cells() const { return cell_key_.size(); }
 
-  // Node data, as UniformGrid's ------------------------------------------------------------
-  std::vector<double> m;
-  std::vector<Vec<D>> v;
-  std::vector<Vec<D>> a;
-  std::vector<Vec<D>> v_remap;
-  std::vector<std::uint8_t> rigid;
-  void clear(bool remap, bool rigid_bodies = false) {
-    clear_nodes<D>(m, v, a, v_remap, rigid, clean_, remap, rigid_bodies);
-  }
-
-  // Boundary conditions: active nodes on constrained domain faces ---------------------------
-  using FaceNode = typename UniformGrid<D>::FaceNode;
-  const std::vector<FaceNode>& fixed_nodes() const { return fixed_; }
-  const std::vector<FaceNode>& slip_nodes() const { return slip_; }
-  const BoundarySpec& boundary() const { return boundary_; }
+  // Node data and constrained nodes (the active ones): GridNodes.
 
  private:
   bool in_box(const IVec<D>& cell) const {
@@ -95,15 +80,12 @@ class SparseGrid : public CellLattice<D> {
     return k;
   }
 
-  BoundarySpec boundary_;
   IVec<D> lo_, hi_;  ///< the box of active cells (inclusive)
   std::array<std::size_t, D> stride_{};  ///< of the box's cells
   int slab_ = D - 1;
-  bool clean_ = false;
   std::vector<std::int32_t> cell_key_;    ///< box cell -> key, -1 when inactive
   std::vector<std::int32_t> cell_nodes_;  ///< key -> its kMaxNodes node indices
   std::vector<std::int32_t> cell_layer_;  ///< key -> slab layer
-  std::vector<FaceNode> fixed_, slip_;
 };
 
 }  // namespace mpm
