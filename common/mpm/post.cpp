@@ -87,6 +87,7 @@ TaylorResult TaylorMeter::measure(const Frame& frame) const {
 
   double L = 0, R = 0;
   std::vector<double> u, w;  // the particles' coordinates across the axis (3D)
+  if (d == 3) u.reserve(r.particles), w.reserve(r.particles);
   const int a1 = (ax + 1) % 3, a2 = (ax + 2) % 3;
   double lat_lo = 1e300, lat_hi = -1e300;  // 2D: the one coordinate across the axis
   const int lat = d == 2 ? 1 - ax : -1;
@@ -112,8 +113,8 @@ TaylorResult TaylorMeter::measure(const Frame& frame) const {
     r.D = c.mean + add, r.D_min = c.min + add, r.D_max = c.max + add;
     r.D_radius = 2 * R + add;
   } else if (scene_.axisymmetric) {
-    // x is the radius: the foot is a disc whose diameter is twice its largest radius.
-    r.D = r.D_min = r.D_max = r.D_radius = 2 * std::max(std::abs(lat_lo), std::abs(lat_hi)) + add;
+    // x is the radius (never negative): the foot is a disc twice its largest radius across.
+    r.D = r.D_min = r.D_max = r.D_radius = 2 * lat_hi + add;
   } else {
     r.D = r.D_min = r.D_max = lat_hi - lat_lo + add;
     r.D_radius = 2 * R + add;

@@ -3,11 +3,11 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <array>
 
 namespace mpm {
 
