@@ -1,6 +1,6 @@
 #pragma once
 /// Explicit MPM: USF, USL and MUSL with leapfrog time integration (000, section 2;
-/// 004, sections 2 and 3.4), in 3D, 2D plane strain and 2D axisymmetry, on any grid type
+/// 004, sections 2 and 3.4), in 3D, 2D plane strain, plane stress and axisymmetry, on any grid type
 /// that provides the interface described in grid.hpp (a uniform window here).
 /// The time step, ExplicitSolver::step, is at the top of explicit_solver_impl.hpp.
 #include <algorithm>
@@ -242,6 +242,7 @@ class ExplicitSolver {
   std::vector<PrivateGrid> private_;  ///< array expansion: per thread; patch: per patch
   std::vector<std::vector<std::uint32_t>> pindex_;  ///< patch: particles of each patch
   bool axisymmetric_ = false;
+  bool plane_stress_ = false;  ///< 2D: sigma_zz = 0 (the material update solves for L_zz)
   bool has_rigid_ = false;
   std::vector<Vec<D>> rigid_velocity_;  ///< by body; zero for deformable bodies
   std::vector<Vec3> rigid_force_;

@@ -87,6 +87,7 @@ ExplicitSolver<GridT>::ExplicitSolver(const Scene& scene, GridT grid, ColumnStor
       scheme_(scene.solver.scheme),
       strategy_(strategy),
       axisymmetric_(D == 2 && scene.axisymmetric),
+      plane_stress_(D == 2 && scene.plane_stress),
       cfl_(scene.solver.cfl),
       dt_max_(scene.solver.dt_max) {
   prepare_columns(particles_, scene_);
@@ -743,6 +744,7 @@ void ExplicitSolver<GridT>::update_stress(const std::vector<Vec<D>>& v_grad, boo
         blk.T = p.T ? p.T + i0 : nullptr;
         blk.failed = p.failed ? p.failed + i0 : nullptr;
         blk.c = scr.c;
+        blk.plane_stress = plane_stress_;
         materials_[mat].update(blk, scr.S);
         for (int j = 0; j < k; ++j) {
           const std::uint32_t i = i0 + j;

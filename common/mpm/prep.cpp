@@ -111,8 +111,9 @@ int prepare_model(const PrepOptions& opt) {
   if (!opt.quiet) {
     std::fprintf(stderr, "mpm-prep: %s%s%s (%dD%s)\n", scene.source.c_str(),
                  scene.title.empty() ? "" : ": ", scene.title.c_str(), d,
-                 d == 2 ? (scene.axisymmetric ? ", axisymmetric, masses per radian"
-                                              : ", plane strain, masses per metre")
+                 d == 2 ? (scene.axisymmetric   ? ", axisymmetric, masses per radian"
+                           : scene.plane_stress ? ", plane stress, masses per metre of initial thickness"
+                                                : ", plane strain, masses per metre")
                         : "");
     std::fprintf(stderr, "  grid: cell %s mm, domain [%s, %s] x [%s, %s]", mm(lattice.h).c_str(),
                  mm(lattice.origin[0]).c_str(), mm(lattice.max()[0]).c_str(),

@@ -1040,10 +1040,13 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
       t->check("dimension", *d == 2 || *d == 3, "must be 3, or 2 (the x-y plane)");
       s.dimension = static_cast<int>(*d);
     }
-    if (auto g = t->choice<bool>("geometry", {{"plane-strain", false}, {"axisymmetric", true}})) {
+    if (auto g = t->choice<int>("geometry",
+                                {{"plane-strain", 0}, {"axisymmetric", 1}, {"plane-stress", 2}})) {
       if (s.dimension != 2)
-        t->fail("geometry", "is for 2D scenes (dimension = 2): \"plane-strain\" or \"axisymmetric\"");
-      s.axisymmetric = *g;
+        t->fail("geometry", "is for 2D scenes (dimension = 2): \"plane-strain\", "
+                            "\"plane-stress\" or \"axisymmetric\"");
+      s.axisymmetric = *g == 1;
+      s.plane_stress = *g == 2;
     }
     t->finish();
   }

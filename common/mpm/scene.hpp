@@ -214,6 +214,7 @@ struct Scene {
   std::string title;
   int dimension = 3;       ///< 3, or 2 (x-y plane)
   bool axisymmetric = false;  ///< 2D only: x is the radius, y the axis; else plane strain
+  bool plane_stress = false;  ///< 2D only: sigma_zz = 0, the thickness follows (thin sheets)
   std::vector<MaterialSpec> materials;
   std::vector<BodySpec> bodies;
   std::vector<LoadSpec> loads;

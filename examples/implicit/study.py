@@ -96,7 +96,7 @@ class Tools:
         sh([self.post, 'history', stream, '-o', hist])
         best['history'] = read_csv(hist)
         part = os.path.join(OUT, name + '_particles.csv')
-        sh([self.post, 'particles', stream, '-o', part, '--columns', 'x,sigma,material'])
+        sh([self.post, 'particles', stream, '-o', part, '--columns', 'x,m,sigma,material'])
         best['particles'] = read_csv(part)
         return best
 
@@ -114,6 +114,24 @@ def material(rows):
 def sxx(run):
     s = [r['sigma_0'] for r in material(run['particles'])]
     return sum(s) / len(s), min(s), max(s)
+
+
+def nodal_sxx(run, h=0.1):
+    """sigma_xx on the mesh as the seed graphs it (001, Fig. 1b): mass-weighted bilinear
+    projection onto the bar's interior nodes, x = 0.4 ... 0.7 on the rows y = 0.2 and 0.3.
+    Returns (mean, min, max) over those nodes."""
+    acc = {}
+    for r in material(run['particles']):
+        x, y = r['x_0'] / h, r['x_1'] / h
+        i, j = int(x), int(y)
+        fx, fy = x - i, y - j
+        for di, wx in ((0, 1 - fx), (1, fx)):
+            for dj, wy in ((0, 1 - fy), (1, fy)):
+                a = acc.setdefault((i + di, j + dj), [0.0, 0.0])
+                a[0] += r['m'] * wx * wy * r['sigma_0']
+                a[1] += r['m'] * wx * wy
+    v = [acc[(i, j)][0] / acc[(i, j)][1] for j in (2, 3) for i in range(4, 8)]
+    return sum(v) / len(v), min(v), max(v)
 
 
 def r_max_mm(run):
@@ -230,19 +248,26 @@ def study(tools, quick):
         rel = lambda a, b: abs(sxx(b)[0] / sxx(a)[0] - 1)
         for solver in ('cg', 'gmres'):
             table(problem, solver, model, ref, bar_cases, rel, 'sigma_xx error vs explicit')
-        # The stress against the seed: plane strain as specified, and with nu = 0 (where plane
-        # strain is uniaxial stress, the seed's assumption), at t and at the strain the seed quotes.
-        b = {'plane_strain_nu_0.3': {'explicit': sxx(ref)}}
+        # The stress against the seed: as specified in plane stress (the scenes) and in plane
+        # strain, and with nu = 0 (where both are uniaxial stress, the seed's assumption) at t
+        # and at the strain the seed quotes. Particles (mean, min, max) and the mesh (nodal).
         imp = results['runs'][f'{problem}_gmres_100a']
-        b['plane_strain_nu_0.3']['implicit_100a'] = sxx(imp)
+        b = {'plane_stress_nu_0.3': {'explicit': sxx(ref), 'implicit_100a': sxx(imp),
+                                     'explicit_nodes': nodal_sxx(ref), 'implicit_100a_nodes': nodal_sxx(imp)}}
+        implicit_sets = ['solver.type=implicit', f'solver.implicit.newton_tolerance={TOL[problem][0]}',
+                         f'solver.implicit.linear_tolerance={TOL[problem][1]}']
+        strain_model = tools.model(scene, problem + '_plane_strain', ['scene.geometry=plane-strain'])
+        ex = tools.simulate(strain_model, problem + '_plane_strain_explicit')
+        im = tools.simulate(strain_model, problem + '_plane_strain_implicit', implicit_sets)
+        b['plane_strain_nu_0.3'] = {'explicit': sxx(ex), 'implicit_100a': sxx(im),
+                                    'explicit_nodes': nodal_sxx(ex), 'implicit_100a_nodes': nodal_sxx(im)}
         for nu_t in (t_check, t_check * (1.0345 if problem == 'elastic_bar' else 1.0125)):
             name = f'{problem}_nu0_t{nu_t:.4g}'
             ex = tools.simulate(model, name + '_explicit', ['materials.bar.poisson_ratio=0', f'solver.end_time={nu_t}'])
-            im = tools.simulate(model, name + '_implicit', ['materials.bar.poisson_ratio=0', f'solver.end_time={nu_t}',
-                                                            'solver.type=implicit',
-                                                            f'solver.implicit.newton_tolerance={TOL[problem][0]}',
-                                                            f'solver.implicit.linear_tolerance={TOL[problem][1]}'])
-            b[f'nu_0_t_{nu_t:.4g}'] = {'explicit': sxx(ex), 'implicit_100a': sxx(im)}
+            im = tools.simulate(model, name + '_implicit', ['materials.bar.poisson_ratio=0', f'solver.end_time={nu_t}']
+                                + implicit_sets)
+            b[f'nu_0_t_{nu_t:.4g}'] = {'explicit': sxx(ex), 'implicit_100a': sxx(im),
+                                       'explicit_nodes': nodal_sxx(ex), 'implicit_100a_nodes': nodal_sxx(im)}
         results['bars'][problem] = b
 
     # Disks -----------------------------------------------------------------------------------
@@ -324,14 +349,17 @@ def study(tools, quick):
     md.append('')
 
     # Bars, disks, upsetting summaries --------------------------------------------------------
-    md.append('### Bar stresses (mean, min, max of sigma_xx over the bar\'s particles)')
+    md.append('### Bar stresses: sigma_xx mean, min, max over the bar\'s particles, and over the '
+              'interior nodes (mesh) where the seed graphs it')
     md.append('')
-    md.append('| problem | case | explicit | implicit (GMRES, 100x, ramp a) |')
-    md.append('|---|---|---|---|')
+    md.append('| problem | case | explicit, particles | explicit, mesh | implicit (100x), particles '
+              '| implicit (100x), mesh |')
+    md.append('|---|---|---|---|---|---|')
     for problem, b in results['bars'].items():
         for case, v in b.items():
-            md.append(f'| {problem} | {case} | ' + ', '.join(fmt(x) for x in v['explicit']) + ' | ' +
-                      ', '.join(fmt(x) for x in v['implicit_100a']) + ' |')
+            md.append(f'| {problem} | {case} | ' + ' | '.join(
+                ', '.join(fmt(x, 5) for x in v[k])
+                for k in ('explicit', 'explicit_nodes', 'implicit_100a', 'implicit_100a_nodes')) + ' |')
     md.append('')
     md.append('### Colliding disks: energy lost by t = 150 (of the initial kinetic energy)')
     md.append('')

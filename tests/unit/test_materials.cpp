@@ -2,6 +2,7 @@
 // hand-computed or analytic stresses.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 
 #include "mpm/materials/material.hpp"
@@ -34,6 +35,7 @@ struct Point {
   Sym sigma = Sym::Zero();
   double rho, e = 0, eps_p = 0, T = 293, m = 1e-6, c = 0;
   std::uint8_t failed = 0;
+  bool plane_stress = false;
   explicit Point(double rho0) : rho(rho0) {}
   PointFault update(const Material& mat, const Mat3& L, double dt, bool with_T = false,
                     bool with_failure = false) {
@@ -51,6 +53,7 @@ struct Point {
     b.T = with_T ? &T : nullptr;
     b.failed = with_failure ? &failed : nullptr;
     b.c = &c;
+    b.plane_stress = plane_stress;
     mat.update(b, S);
     return b.fault;
   }
@@ -301,6 +304,74 @@ TEST(Materials, JaumannRateRotatesWithoutChangingInvariants) {
   for (int k = 0; k < 1000; ++k) p.update(mat, L, 1e-6);
   EXPECT_NEAR(von_mises(p.sigma), vm0, 1e-3 * vm0);  // first-order rotation: O(w^2 dt^2 k) drift
   EXPECT_NE(p.sigma[5], 4e6);                        // it did rotate
+}
+
+
+// Plane stress, elastic: from rest, one small step with any in-plane rate gives the plane-stress
+// Hooke's law, sigma = E / (1 - nu^2) [eps_xx + nu eps_yy, eps_yy + nu eps_xx], sigma_xy = 2 G
+// eps_xy, sigma_zz = 0, and the density follows the thinning eps_zz = -nu / (1 - nu) (eps_xx +
+// eps_yy). eps = 1e-6: the finite-strain terms of the update are O(eps^2), a relative 1e-6.
+// L(2, 2) on entry is garbage on purpose: plane stress must ignore it.
+TEST(Materials, PlaneStressElasticIsHookesPlaneStressLaw) {
+  MaterialSpec spec = copper();
+  spec.strength.model = StrengthModel::Elastic;
+  const Material mat(spec, no_viscosity());
+  const double E = spec.youngs_modulus, nu = spec.poisson_ratio, G = spec.shear_modulus();
+  const double dt = 1e-9;
+  for (const auto& [exx, eyy, exy] : {std::array{1e-6, 0.0, 0.0}, std::array{1e-6, -0.4e-6, 0.3e-6},
+                                      std::array{-0.7e-6, 0.2e-6, -0.5e-6}}) {
+    Point p(spec.density);
+    p.plane_stress = true;
+    Mat3 L = Mat3::Zero();
+    L(0, 0) = exx / dt;
+    L(1, 1) = eyy / dt;
+    L(0, 1) = L(1, 0) = exy / dt;
+    L(2, 2) = 12345.0;
+    ASSERT_EQ(p.update(mat, L, dt), PointFault::None);
+    const double k = E / (1 - nu * nu), scale = E * 1e-6;
+    EXPECT_NEAR(p.sigma[0], k * (exx + nu * eyy), 3e-6 * scale);
+    EXPECT_NEAR(p.sigma[1], k * (eyy + nu * exx), 3e-6 * scale);
+    EXPECT_NEAR(p.sigma[5], 2 * G * exy, 3e-6 * scale);
+    // Round-off floor: p = K (rho / rho0 - 1) loses 1e-16 / 1e-6 of itself to the density.
+    EXPECT_NEAR(p.sigma[2], 0.0, 1e-9 * scale);
+    const double ezz = -nu / (1 - nu) * (exx + eyy);
+    EXPECT_NEAR(spec.density / p.rho - 1, exx + eyy + ezz, 1e-11);
+  }
+}
+
+// Plane stress, J2: the uniaxial stress path of J2UniaxialStressCurve, with the test solving
+// only for the in-plane lateral rate (sigma_yy = 0) and the material for the thickness rate
+// (sigma_zz = 0). Same analytic curve, same tolerance; sigma_zz stays at round-off through
+// yield, where the secant iteration meets the kink of the radial return.
+TEST(Materials, PlaneStressJ2UniaxialStressCurve) {
+  MaterialSpec spec = copper();
+  const Material mat(spec, no_viscosity());
+  const double E = spec.youngs_modulus, A = spec.strength.A, B = spec.strength.B;
+  Point p(spec.density);
+  p.plane_stress = true;
+  const double rate = 1e3, dt = 1e-7;
+  for (int k = 1; k <= 200; ++k) {
+    auto lateral = [&](double l) {
+      Point q = p;
+      Mat3 L = Mat3::Zero();
+      L(0, 0) = rate;
+      L(1, 1) = l;
+      q.update(mat, L, dt);
+      return q;
+    };
+    double l0 = -0.35 * rate, l1 = -0.5 * rate;
+    double f0 = lateral(l0).sigma[1], f1 = lateral(l1).sigma[1];
+    for (int it = 0; it < 30 && std::abs(f1) > 1e-3; ++it) {
+      const double l2 = l1 - f1 * (l1 - l0) / (f1 - f0);
+      l0 = l1, f0 = f1, l1 = l2, f1 = lateral(l1).sigma[1];
+    }
+    p = lateral(l1);
+    const double eps = std::expm1(rate * dt * k);
+    const double sig_exact = E * eps <= A ? E * eps : (A + B * eps) / (1 + B / E);
+    EXPECT_NEAR(p.sigma[0], sig_exact, 3e-3 * sig_exact + 1e3) << "eps " << eps;
+    EXPECT_NEAR(p.sigma[2], 0.0, 1e-13 * std::abs(p.sigma[0]) + 1e-3) << "eps " << eps;
+  }
+  EXPECT_GT(p.eps_p, 0.015);
 }
 
 }  // namespace

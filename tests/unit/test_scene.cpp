@@ -602,6 +602,12 @@ TEST(SceneErrors, InlineCases) {
        "scene.title: expected a string, got 3 (an integer)"},
       {"unknown key in [scene]", "# minimal scene", "[scene]\ndimensions = 3", "dimensions",
        "scene.dimensions: unknown key (expected one of: title, dimension, geometry)"},
+      {"3D plane stress", "# minimal scene", "[scene]\ngeometry = \"plane-stress\"", "geometry",
+       "scene.geometry: is for 2D scenes (dimension = 2): \"plane-strain\", \"plane-stress\" or "
+       "\"axisymmetric\""},
+      {"bad geometry", "# minimal scene", "[scene]\ndimension = 2\ngeometry = \"shell\"", "shell",
+       "scene.geometry: expected one of \"plane-strain\", \"axisymmetric\", \"plane-stress\", got "
+       "'shell'"},
   };
   for (const auto& c : cases) {
     std::string text = with(kBase, c.from, c.to);

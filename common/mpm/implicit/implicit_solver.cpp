@@ -146,7 +146,8 @@ ImplicitSolver<GridT>::ImplicitSolver(const Scene& scene, GridT grid, ColumnStor
       spec_(scene.solver.implicit),
       particles_(particles),
       grid_(std::move(grid)),
-      axisymmetric_(D == 2 && scene.axisymmetric) {
+      axisymmetric_(D == 2 && scene.axisymmetric),
+      plane_stress_(D == 2 && scene.plane_stress) {
   prepare_columns(particles_, scene_);
   for (const auto& m : scene_.materials) {
     materials_.emplace_back(m, scene_.solver);
@@ -535,6 +536,7 @@ bool ImplicitSolver<GridT>::stress_trial(Trial& t) {
       blk.T = p.T ? t.T.data() + i0 : nullptr;
       blk.failed = p.failed ? t.failed.data() + i0 : nullptr;
       blk.c = scr.c;
+      blk.plane_stress = plane_stress_;
       materials_[mat].update(blk, scr.S);
       if (blk.fault_index >= 0) bad[ch] = 1;
       k = 0;

@@ -139,7 +139,7 @@ class ImplicitSolver {
   GridT grid_;
   Binning binning_;
   std::vector<Material> materials_;
-  bool axisymmetric_ = false, has_rigid_ = false;
+  bool axisymmetric_ = false, plane_stress_ = false, has_rigid_ = false;
   std::vector<Vec<D>> rigid_velocity_;
   std::vector<Vec3> rigid_force_;
   Vec<D> gravity_ = Vec<D>::Zero();

@@ -1,7 +1,9 @@
 // Composition of a material and its constitutive update per block of particles.
 #include "mpm/materials/material.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "mpm/materials/models.hpp"
@@ -57,6 +59,93 @@ double Material::reference_wave_speed() const {
 }
 
 void Material::update(MaterialBlock& b, BlockScratch& S) const {
+  if (b.plane_stress)
+    update_plane_stress(b, S);
+  else
+    update_once(b, S);
+}
+
+// Plane stress: the thickness rate d = L_zz is the one that leaves sigma_zz = 0 after the
+// step. sigma_zz(d) rises with d (by (K + 4G/3) dt elastically, less when plastic), so each
+// particle's root is found by a secant iteration started from the elastic estimate and kept
+// inside a bracket once one is known (bisection when the secant leaves it). Every pass runs
+// the whole block's update from the saved state of t^n, so the strength model, the EOS, the
+// bulk viscosity and failure need no plane-stress variant of their own.
+void Material::update_plane_stress(MaterialBlock& b, BlockScratch& S) const {
+  const int n = b.n;
+  Sym sigma0[kBlock];
+  double rho0[kBlock], e0[kBlock], ep0[kBlock], T0[kBlock];
+  std::uint8_t f0[kBlock];
+  Mat3 L[kBlock];
+  double d[kBlock], d_prev[kBlock], r_prev[kBlock], lo[kBlock], hi[kBlock];
+  bool done[kBlock];
+  const double lambda = K_ - 2.0 * G_ / 3.0, M = K_ + 4.0 / 3.0 * G_;
+  const double k0 = M * b.dt;  // elastic d sigma_zz / d L_zz
+  for (int i = 0; i < n; ++i) {
+    sigma0[i] = b.sigma[i];
+    rho0[i] = b.rho[i];
+    e0[i] = b.e[i];
+    if (b.eps_p) ep0[i] = b.eps_p[i];
+    if (b.T) T0[i] = b.T[i];
+    if (b.failed) f0[i] = b.failed[i];
+    L[i] = b.L[i];
+    // Elastic estimate from the old sigma_zz and the in-plane rate.
+    d[i] = -(lambda * (L[i](0, 0) + L[i](1, 1)) + sigma0[i][2] / b.dt) / M;
+    lo[i] = -std::numeric_limits<double>::infinity();
+    hi[i] = std::numeric_limits<double>::infinity();
+    done[i] = false;
+  }
+  const Mat3* L_in = b.L;
+  b.L = L;
+  for (int pass = 0;; ++pass) {
+    for (int i = 0; i < n; ++i) {
+      b.sigma[i] = sigma0[i];
+      b.rho[i] = rho0[i];
+      b.e[i] = e0[i];
+      if (b.eps_p) b.eps_p[i] = ep0[i];
+      if (b.T) b.T[i] = T0[i];
+      if (b.failed) b.failed[i] = f0[i];
+      L[i](2, 2) = d[i];
+    }
+    b.fault_index = -1;
+    b.fault = PointFault::None;
+    update_once(b, S);
+    if (pass + 1 == kPlaneStressMaxPasses) break;
+    bool all = true;
+    for (int i = 0; i < n; ++i) {
+      if (done[i]) continue;
+      const Sym& s = b.sigma[i];
+      const double r = s[2];
+      const double rate_scale =
+          std::abs(L[i](0, 0)) + std::abs(L[i](1, 1)) + std::abs(L[i](0, 1)) + std::abs(d[i]);
+      const double scale =
+          std::max({std::abs(s[0]), std::abs(s[1]), std::abs(s[5])}) + k0 * rate_scale;
+      if (!(std::abs(r) > 1e-13 * scale) || !std::isfinite(r)) {
+        done[i] = true;
+        continue;
+      }
+      all = false;
+      if (r > 0) hi[i] = std::min(hi[i], d[i]); else lo[i] = std::max(lo[i], d[i]);
+      double next = d[i] - r / k0;
+      if (pass > 0 && r != r_prev[i] && d[i] != d_prev[i]) {
+        const double slope = (r - r_prev[i]) / (d[i] - d_prev[i]);
+        if (slope > 0) next = d[i] - r / slope;
+      }
+      if (!(next > lo[i] && next < hi[i]) && std::isfinite(lo[i]) && std::isfinite(hi[i]))
+        next = 0.5 * (lo[i] + hi[i]);
+      d_prev[i] = d[i];
+      r_prev[i] = r;
+      // Below round-off of the state (the EOS's p is K (rho / rho0 - 1): ~1e-16 / strain of
+      // itself): the rate is converged when the step is, relative to the in-plane rate.
+      if (std::abs(next - d[i]) <= 1e-12 * rate_scale) done[i] = true;
+      d[i] = next;
+    }
+    if (all) break;
+  }
+  b.L = L_in;
+}
+
+void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
   const double dt = b.dt;
   // Kinematics: strain and spin increments, Jaumann rotation, density (000, eqs. 12-15).
   for (int i = 0; i < b.n; ++i) {

@@ -35,6 +35,9 @@ struct MaterialBlock {
   double* T = nullptr;      ///< temperature, K (in/out; nullptr if absent)
   std::uint8_t* failed = nullptr;  ///< failure flag (in/out; nullptr if absent)
   double* c = nullptr;      ///< out: signal speed for the time step, m/s
+  /// 2D plane stress: L(2, 2) on entry is ignored; the update finds the thickness rate that
+  /// makes sigma_zz = 0 for each particle (and the density follows the thinning).
+  bool plane_stress = false;
   int fault_index = -1;     ///< out: first particle whose update failed, -1 if none
   PointFault fault = PointFault::None;
 };
@@ -85,12 +88,19 @@ class Material {
   const Eos& eos() const { return *eos_; }
   double shear_modulus() const { return G_; }
   /// Constitutive update of one block (000, eqs. 12-15; Jaumann rate, radial return, EOS with
-  /// internal energy, artificial bulk viscosity, failure). `S` is per-thread scratch.
+  /// internal energy, artificial bulk viscosity, failure). `S` is per-thread scratch. With
+  /// `blk.plane_stress` the out-of-plane rate is solved for, per particle, by a safeguarded
+  /// secant iteration on sigma_zz = 0 around the whole update (any strength, EOS and failure).
   void update(MaterialBlock& blk, BlockScratch& S) const;
+  /// Cap on the update passes of a plane-stress block (each pass updates the whole block).
+  static constexpr int kPlaneStressMaxPasses = 30;
   /// Signal speed (m/s) of the unstressed material: sqrt((K + 4G/3)/rho0).
   double reference_wave_speed() const;
 
  private:
+  void update_once(MaterialBlock& blk, BlockScratch& S) const;
+  void update_plane_stress(MaterialBlock& blk, BlockScratch& S) const;
+
   MaterialSpec spec_;
   double G_ = 0, K_ = 0;
   double bulk_linear_ = 0, bulk_quadratic_ = 0;
