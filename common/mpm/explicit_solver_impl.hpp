@@ -745,6 +745,7 @@ void ExplicitSolver<GridT>::update_stress(const std::vector<Vec<D>>& v_grad, boo
         blk.failed = p.failed ? p.failed + i0 : nullptr;
         blk.c = scr.c;
         blk.plane_stress = plane_stress_;
+        blk.thickness = p.thickness ? p.thickness + i0 : nullptr;
         materials_[mat].update(blk, scr.S);
         for (int j = 0; j < k; ++j) {
           const std::uint32_t i = i0 + j;

@@ -1,5 +1,7 @@
 #include "mpm/particles.hpp"
 
+#include <algorithm>
+
 #include "mpm/error.hpp"
 
 namespace mpm {
@@ -66,6 +68,11 @@ void prepare_columns(ColumnStore& cols, const Scene& scene) {
     ensure(cols, {col::strain, ScalarType::F64, d, "-"});
     ensure(cols, {col::level, ScalarType::U8, 1, "-"});
   }
+  if (d == 2 && scene.plane_stress && !cols.has(col::thickness)) {
+    cols.add({col::thickness, ScalarType::F64, 1, "-"});
+    double* h = cols.get<double>(col::thickness);
+    std::fill(h, h + cols.size(), 1.0);
+  }
   if (need.T && !cols.has(col::T)) {
     cols.add({col::T, ScalarType::F64, 1, "K"});
     double* T = cols.get<double>(col::T);
@@ -115,6 +122,7 @@ ParticleView<D> view(ColumnStore& cols) {
   p.failed = cols.get<std::uint8_t>(col::failed);
   p.f_ext = cols.get<Vec<D>>(col::f_ext);
   p.strain = cols.get<Vec<D>>(col::strain);
+  p.thickness = cols.get<double>(col::thickness);
   p.id = cols.get<std::uint32_t>(col::id);
   p.material = cols.get<std::uint8_t>(col::material);
   p.body = cols.get<std::uint8_t>(col::body);

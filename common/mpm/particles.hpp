@@ -29,6 +29,7 @@ inline const std::string failed = "failed";      ///< u8, 1 once the failure cri
 inline const std::string f_ext = "f_ext";        ///< D x f64, applied force (loads), N
 inline const std::string strain = "strain";      ///< D x f64, accumulated normal strains (graded grids)
 inline const std::string level = "level";        ///< u8, grid level of the particle's spacing (graded grids)
+inline const std::string thickness = "thickness";  ///< f64, thickness / initial thickness (plane stress)
 }  // namespace col
 
 /// Material id of the particles of rigid bodies (they have no material).
@@ -50,6 +51,7 @@ struct ParticleView {
   std::uint8_t* failed = nullptr;
   Vec<D>* f_ext = nullptr;
   Vec<D>* strain = nullptr;  ///< integral of the rate of deformation's diagonal (graded grids)
+  double* thickness = nullptr;  ///< thickness / initial thickness (plane stress)
   std::uint32_t* id = nullptr;
   std::uint8_t* material = nullptr;
   std::uint8_t* body = nullptr;
@@ -64,7 +66,8 @@ struct ColumnNeeds {
 ColumnNeeds column_needs(const Scene& scene);
 
 /// Adds the state columns a run needs to a model's columns (sigma, e and the optional ones),
-/// initialised to the unstressed state (T to each material's room temperature; f_ext from the
+/// initialised to the unstressed state (T to each material's room temperature; thickness to 1
+/// in plane stress; f_ext from the
 /// scene's loads, shared equally among the particles each load selects), and checks the
 /// model's own columns (x, v, m, rho, id, material, body) exist with the right shape.
 /// Throws InputError naming the missing or malformed column, or a load that selects nothing.

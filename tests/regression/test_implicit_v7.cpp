@@ -66,9 +66,9 @@ Case run_case(const std::string& name) {
 }
 
 /// The deformable particles of the last frame.
-std::vector<std::map<std::string, double>> material(const Case& c) {
-  const Result r =
-      run(post + " particles " + c.stream.string() + " --columns x,m,sigma,material", c.dir);
+std::vector<std::map<std::string, double>> material(const Case& c,
+                                                    const std::string& columns = "x,m,sigma,material") {
+  const Result r = run(post + " particles " + c.stream.string() + " --columns " + columns, c.dir);
   EXPECT_EQ(r.status, 0) << r.err;
   auto rows = csv(r.out);
   std::erase_if(rows, [](auto& p) { return p["material"] == 255; });
@@ -112,6 +112,14 @@ void bar(const std::string& name) {
     const auto [lo, hi] = std::minmax_element(nodal.begin(), nodal.end());
     for (double s : nodal) EXPECT_NEAR(s, expect, c.ref["nodal_tolerance"].value_or(0.0) * expect);
     EXPECT_LT((*hi - *lo) / expect, c.ref["nodal_spread"].value_or(0.0)) << "uniform along the bar";
+  }
+  if (c.ref["thickness_tolerance"]) {  // plane stress: ln(h / h0) = eps_zz = -nu / E (s_xx + s_yy)
+    const double E = c.ref["youngs_modulus"].value_or(0.0), nu = c.ref["poisson_ratio"].value_or(0.0);
+    for (auto& p : material(c, "x,sigma,thickness,material")) {
+      const double ezz = -nu / E * (p.at("sigma_0") + p.at("sigma_1"));
+      EXPECT_NEAR(std::log(p.at("thickness")), ezz,
+                  c.ref["thickness_tolerance"].value_or(0.0) * std::abs(ezz));
+    }
   }
   ASSERT_EQ(rows.size(), 36u);
   double sum = 0, lo = 1e300, hi = -1e300;

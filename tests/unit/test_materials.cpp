@@ -36,6 +36,7 @@ struct Point {
   double rho, e = 0, eps_p = 0, T = 293, m = 1e-6, c = 0;
   std::uint8_t failed = 0;
   bool plane_stress = false;
+  double thickness = 1;
   explicit Point(double rho0) : rho(rho0) {}
   PointFault update(const Material& mat, const Mat3& L, double dt, bool with_T = false,
                     bool with_failure = false) {
@@ -54,6 +55,7 @@ struct Point {
     b.failed = with_failure ? &failed : nullptr;
     b.c = &c;
     b.plane_stress = plane_stress;
+    b.thickness = plane_stress ? &thickness : nullptr;
     mat.update(b, S);
     return b.fault;
   }
@@ -336,6 +338,7 @@ TEST(Materials, PlaneStressElasticIsHookesPlaneStressLaw) {
     EXPECT_NEAR(p.sigma[2], 0.0, 1e-9 * scale);
     const double ezz = -nu / (1 - nu) * (exx + eyy);
     EXPECT_NEAR(spec.density / p.rho - 1, exx + eyy + ezz, 1e-11);
+    EXPECT_NEAR(p.thickness - 1, ezz, 1e-11);
   }
 }
 

@@ -82,7 +82,7 @@ ImplicitWork& ImplicitWork::operator+=(const ImplicitWork& o) {
 template <class GridT>
 struct ImplicitSolver<GridT>::Trial {
   std::vector<Sym> sigma;
-  std::vector<double> rho, e, eps_p, T;
+  std::vector<double> rho, e, eps_p, T, thickness;
   std::vector<std::uint8_t> failed;
   std::vector<Vec<D>> v_p;  ///< momentum formulation: particle velocities v_p^L (eq. 3.2.6)
   std::vector<Vec<D>> v_i;  ///< grid velocity the strain increment came from (eq. 3.2.7)
@@ -94,6 +94,7 @@ struct ImplicitSolver<GridT>::Trial {
     e.resize(n);
     eps_p.resize(p.eps_p ? n : 0);
     T.resize(p.T ? n : 0);
+    thickness.resize(p.thickness ? n : 0);
     failed.resize(p.failed ? n : 0);
     v_p.resize(n);
     v_i.resize(nodes);
@@ -522,6 +523,7 @@ bool ImplicitSolver<GridT>::stress_trial(Trial& t) {
         if (p.eps_p) t.eps_p[i] = p.eps_p[i];
         if (p.T) t.T[i] = p.T[i];
         if (p.failed) t.failed[i] = p.failed[i];
+        if (p.thickness) t.thickness[i] = p.thickness[i];
       }
       MaterialBlock blk;
       blk.n = k;
@@ -537,6 +539,7 @@ bool ImplicitSolver<GridT>::stress_trial(Trial& t) {
       blk.failed = p.failed ? t.failed.data() + i0 : nullptr;
       blk.c = scr.c;
       blk.plane_stress = plane_stress_;
+      blk.thickness = p.thickness ? t.thickness.data() + i0 : nullptr;
       materials_[mat].update(blk, scr.S);
       if (blk.fault_index >= 0) bad[ch] = 1;
       k = 0;
@@ -755,6 +758,7 @@ void ImplicitSolver<GridT>::commit(const nk::Vector& u) {
           if (p.eps_p) p.eps_p[i] = t.eps_p[i];
           if (p.T) p.T[i] = t.T[i];
           if (p.failed) p.failed[i] = t.failed[i];
+          if (p.thickness) p.thickness[i] = t.thickness[i];
           s.kinetic += 0.5 * p.m[i] * p.v[i].squaredNorm();
           s.internal += p.m[i] * p.e[i];
           for (int a = 0; a < D; ++a) s.momentum[a] += p.m[i] * p.v[i][a];

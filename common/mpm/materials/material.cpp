@@ -143,6 +143,8 @@ void Material::update_plane_stress(MaterialBlock& b, BlockScratch& S) const {
     if (all) break;
   }
   b.L = L_in;
+  if (b.thickness)  // as the density: V_new = V_old (1 + tr(D) dt), of which (1 + d dt) across
+    for (int i = 0; i < n; ++i) b.thickness[i] *= 1.0 + L[i](2, 2) * b.dt;
 }
 
 void Material::update_once(MaterialBlock& b, BlockScratch& S) const {

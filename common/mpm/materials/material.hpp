@@ -38,6 +38,7 @@ struct MaterialBlock {
   /// 2D plane stress: L(2, 2) on entry is ignored; the update finds the thickness rate that
   /// makes sigma_zz = 0 for each particle (and the density follows the thinning).
   bool plane_stress = false;
+  double* thickness = nullptr;  ///< plane stress: thickness / initial thickness (in/out; may be null)
   int fault_index = -1;     ///< out: first particle whose update failed, -1 if none
   PointFault fault = PointFault::None;
 };
