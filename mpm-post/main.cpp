@@ -668,8 +668,11 @@ int cmd_render(const std::string& path, RenderArgs& a) {
   }
   const int dim = chosen->columns.at("x").info().components;
   render_png(*chosen, dim, o, a.output);
-  std::fprintf(stderr, "mpm-post: wrote %s (frame at t = %.4g us, %zu particles, coloured by %s)\n",
-               a.output.c_str(), chosen->time * 1e6, chosen->columns.size(), o.field.c_str());
+  // The time in us for impact runs, in s for slow ones (forming, the dimensionless V7 scenes).
+  const bool slow = chosen->time >= 1e-2;
+  std::fprintf(stderr, "mpm-post: wrote %s (frame at t = %.4g %s, %zu particles, coloured by %s)\n",
+               a.output.c_str(), slow ? chosen->time : chosen->time * 1e6, slow ? "s" : "us",
+               chosen->columns.size(), o.field.c_str());
   return conclude(path, s, std::size_t(index));
 }
 
