@@ -93,7 +93,8 @@ int prepare_model(const PrepOptions& opt) {
   const ColumnNeeds need = column_needs(scene);
   const int d = scene.dimension;
   const double bytes_particle = 2 * d * 8 + 3 * 8 + 48 + 4 + 1 + 1 + (need.eps_p ? 8 : 0) +
-                                (need.T ? 8 : 0) + (need.failed ? 1 : 0);
+                                (need.T ? 8 : 0) + (need.failed ? 1 : 0) +
+                                (d == 2 && scene.plane_stress ? 8 : 0);  // thickness
   // Grid window around the bodies: cells of the particles' bounding box, 8 + 3 d 8 bytes a node.
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
   {
