@@ -497,7 +497,7 @@ struct ProfileArgs {
   std::vector<std::string> times;
   std::vector<long> frames;
   ProfileOptions opt;
-  bool json = false;
+  bool json = false, grid = false;
 };
 
 Vec3 point(const std::string& text, const std::string& option) {
@@ -540,13 +540,25 @@ int cmd_profile(const std::string& path, ProfileArgs& a) {
   StreamVisitor v;
   v.scene = [&](const std::string& t) {
     scene_text = t;
-    if (!a.body.empty()) {
+    if (!a.body.empty() || a.grid) {
       const Scene sc = scene_of(scene_text, path);
-      o.body = sc.body_index(a.body);
-      if (o.body < 0) throw InputError("--body", "no body named '" + a.body + "' in the scene");
+      if (!a.body.empty()) {
+        o.body = sc.body_index(a.body);
+        if (o.body < 0) throw InputError("--body", "no body named '" + a.body + "' in the scene");
+      }
+      if (a.grid) {
+        if (!sc.grid.levels.empty())
+          throw InputError("--grid", "the run's grid is graded (grid.levels): profiles on the grid need a uniform one");
+        if (!sc.grid.domain_given)
+          throw InputError("--grid", "the stream's scene has no grid.domain (written by an older mpm-prep?)");
+        o.on_grid = true;
+        o.cell = sc.grid.cell_size;
+        o.origin = sc.grid.domain_min;
+      }
     }
   };
   v.frame = [&](Frame&& f) {
+    if (a.grid && !o.on_grid) throw InputError("--grid", "the stream holds no scene before its frames");
     const long k = index++;
     const int dim = f.columns.at("x").info().components;
     std::shared_ptr<Profile> p;
@@ -765,6 +777,7 @@ int main(int argc, char** argv) {
   profile->add_option("--radius", pa.radius, "leave out particles farther than this from the line, e.g. \"1 mm\" (default: none)");
   profile->add_option("--body", pa.body, "only this body's particles");
   profile->add_option("--bins", pa.opt.bins, "average in this many equal bins along the line (default: one row per particle)");
+  profile->add_flag("--grid", pa.grid, "on the grid: project the field onto the run's grid nodes (linear shape functions, mass-weighted) and profile the nodes near the line");
   profile->add_option("--time", pa.times, "the frame nearest this time, e.g. 9us (repeatable)");
   profile->add_option("--frame", pa.frames, "frame index, 0 = first (repeatable); default: the last frame");
   profile->add_flag("--json", pa.json, "print JSON (SI units)");

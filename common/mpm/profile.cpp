@@ -2,7 +2,9 @@
 #include "mpm/profile.hpp"
 
 #include <algorithm>
+#include <array>
 #include <functional>
+#include <map>
 #include <cmath>
 #include <cstring>
 #include <numeric>
@@ -134,16 +136,54 @@ Profile make_profile(const Frame& frame, int dim, const ProfileOptions& o) {
     double s, v, w;
   };
   std::vector<Row> rows;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!selected(i)) continue;
-    const Vec3 r = pos(i) - p.from;
-    const double s = r.dot(e);
-    if (s < -1e-12 * length || s > length * (1 + 1e-12)) continue;
-    if ((r - s * e).norm() > o.radius) continue;
-    rows.push_back({s, value(i), weight(i)});
+  auto near = [&](const Vec3& x, double& s) {
+    const Vec3 r = x - p.from;
+    s = r.dot(e);
+    return s >= -1e-12 * length && s <= length * (1 + 1e-12) && (r - s * e).norm() <= o.radius * (1 + 1e-12);
+  };
+  if (o.on_grid) {
+    // Particle to grid with the solver's linear shape functions, mass-weighted.
+    if (!(o.cell > 0)) throw InputError("--grid", "the grid's cell size is unknown");
+    std::map<std::array<long, 3>, std::pair<double, double>> nodes;  // (sum w m v, sum w m)
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!selected(i)) continue;
+      const Vec3 xi = (pos(i) - o.origin) / o.cell;
+      std::array<long, 3> c{0, 0, 0};
+      Vec3 f = Vec3::Zero();
+      for (int a = 0; a < dim; ++a) c[a] = long(std::floor(xi[a])), f[a] = xi[a] - double(c[a]);
+      const double m = mc ? value_at(*mc, i, 0) : 1.0, v = value(i);
+      for (int corner = 0; corner < (1 << dim); ++corner) {
+        std::array<long, 3> k = c;
+        double w = m;
+        for (int a = 0; a < dim; ++a) {
+          const int up = (corner >> a) & 1;
+          k[a] += up;
+          w *= up ? f[a] : 1.0 - f[a];
+        }
+        auto& acc = nodes[k];
+        acc.first += w * v;
+        acc.second += w;
+      }
+    }
+    for (const auto& [k, acc] : nodes) {
+      if (!(acc.second > 0)) continue;
+      Vec3 x = o.origin;
+      for (int a = 0; a < dim; ++a) x[a] += double(k[a]) * o.cell;
+      double s;
+      if (near(x, s)) rows.push_back({s, acc.first / acc.second, acc.second});
+    }
+    if (rows.empty())
+      throw InputError("profile", "no grid node with mass lies within --radius of the line at t = " +
+                                      std::to_string(frame.time) + " s (nodes are " +
+                                      std::to_string(o.cell) + " m apart)");
+  } else {
+    for (std::size_t i = 0; i < n; ++i) {
+      double s;
+      if (selected(i) && near(pos(i), s)) rows.push_back({s, value(i), weight(i)});
+    }
+    if (rows.empty())
+      throw InputError("profile", "no particle lies within --radius of the line at t = " + std::to_string(frame.time) + " s");
   }
-  if (rows.empty())
-    throw InputError("profile", "no particle lies within --radius of the line at t = " + std::to_string(frame.time) + " s");
   std::stable_sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) { return a.s < b.s; });
   if (o.bins <= 0) {
     for (const Row& r : rows) {

@@ -22,12 +22,20 @@ struct ProfileOptions {
   double radius = std::numeric_limits<double>::infinity();  ///< m: particles farther off are left out
   int body = -1;                ///< only this body's particles; -1: all
   int bins = 0;                 ///< 0: one row per particle; else equal bins over the line
+  /// On the grid: the field projected onto the nodes of the run's uniform grid (cell size
+  /// `cell`, a node at `origin`) with the linear shape functions, weighted by particle mass as
+  /// the solver's particle-to-grid transfer weights momentum; the rows are then the nodes within
+  /// `radius` of the line (the way MPM papers graph stresses "on the mesh").
+  bool on_grid = false;
+  double cell = 0;              ///< m
+  Vec3 origin = Vec3::Zero();   ///< m
 };
 
 /// One profile. Per particle (bins = 0): s, value, weight (sorted by s). In bins: s is the bin
 /// centre, value the weighted mean, min and max the extremes, count the particles.
 /// Weights are particle volumes m / rho (m^3, per metre in 2D) when the frame holds m and rho,
-/// else 1.
+/// else 1. On the grid the rows are nodes and the weights their masses (kg; 1 a particle
+/// without the column m).
 struct Profile {
   double time = 0;  ///< s
   Vec3 from = Vec3::Zero(), to = Vec3::Zero();

@@ -96,7 +96,7 @@ class Tools:
         sh([self.post, 'history', stream, '-o', hist])
         best['history'] = read_csv(hist)
         part = os.path.join(OUT, name + '_particles.csv')
-        sh([self.post, 'particles', stream, '-o', part, '--columns', 'x,m,sigma,material'])
+        sh([self.post, 'particles', stream, '-o', part, '--columns', 'x,sigma,material'])
         best['particles'] = read_csv(part)
         return best
 
@@ -116,21 +116,19 @@ def sxx(run):
     return sum(s) / len(s), min(s), max(s)
 
 
-def nodal_sxx(run, h=0.1):
-    """sigma_xx on the mesh as the seed graphs it (001, Fig. 1b): mass-weighted bilinear
-    projection onto the bar's interior nodes, x = 0.4 ... 0.7 on the rows y = 0.2 and 0.3.
+def nodal_sxx(tools, run):
+    """sigma_xx on the mesh as the seed graphs it (001, Fig. 1b): `mpm-post profile --grid`
+    (the bar's particles projected onto the grid nodes, mass-weighted, with the solver's shape
+    functions) at the bar's interior nodes, x = 0.4 ... 0.7 on the rows y = 0.2 and 0.3.
     Returns (mean, min, max) over those nodes."""
-    acc = {}
-    for r in material(run['particles']):
-        x, y = r['x_0'] / h, r['x_1'] / h
-        i, j = int(x), int(y)
-        fx, fy = x - i, y - j
-        for di, wx in ((0, 1 - fx), (1, fx)):
-            for dj, wy in ((0, 1 - fy), (1, fy)):
-                a = acc.setdefault((i + di, j + dj), [0.0, 0.0])
-                a[0] += r['m'] * wx * wy * r['sigma_0']
-                a[1] += r['m'] * wx * wy
-    v = [acc[(i, j)][0] / acc[(i, j)][1] for j in (2, 3) for i in range(4, 8)]
+    v = []
+    for y in (0.2, 0.3):
+        r = sh([tools.post, 'profile', run['stream'], '--grid', '--body', 'bar', '--field', 'sigma',
+                '--component', 'xx', '--from', f'0.4 {y}', '--to', f'0.7 {y}', '--radius', '1e-6'])
+        if r.returncode != 0:
+            sys.exit(f'mpm-post profile --grid failed: {r.stderr}')
+        rows = list(csv.DictReader(r.stdout.splitlines()))
+        v += [float(row['value']) for row in rows]
     return sum(v) / len(v), min(v), max(v)
 
 
@@ -253,21 +251,21 @@ def study(tools, quick):
         # and at the strain the seed quotes. Particles (mean, min, max) and the mesh (nodal).
         imp = results['runs'][f'{problem}_gmres_100a']
         b = {'plane_stress_nu_0.3': {'explicit': sxx(ref), 'implicit_100a': sxx(imp),
-                                     'explicit_nodes': nodal_sxx(ref), 'implicit_100a_nodes': nodal_sxx(imp)}}
+                                     'explicit_nodes': nodal_sxx(tools, ref), 'implicit_100a_nodes': nodal_sxx(tools, imp)}}
         implicit_sets = ['solver.type=implicit', f'solver.implicit.newton_tolerance={TOL[problem][0]}',
                          f'solver.implicit.linear_tolerance={TOL[problem][1]}']
         strain_model = tools.model(scene, problem + '_plane_strain', ['scene.geometry=plane-strain'])
         ex = tools.simulate(strain_model, problem + '_plane_strain_explicit')
         im = tools.simulate(strain_model, problem + '_plane_strain_implicit', implicit_sets)
         b['plane_strain_nu_0.3'] = {'explicit': sxx(ex), 'implicit_100a': sxx(im),
-                                    'explicit_nodes': nodal_sxx(ex), 'implicit_100a_nodes': nodal_sxx(im)}
+                                    'explicit_nodes': nodal_sxx(tools, ex), 'implicit_100a_nodes': nodal_sxx(tools, im)}
         for nu_t in (t_check, t_check * (1.0345 if problem == 'elastic_bar' else 1.0125)):
             name = f'{problem}_nu0_t{nu_t:.4g}'
             ex = tools.simulate(model, name + '_explicit', ['materials.bar.poisson_ratio=0', f'solver.end_time={nu_t}'])
             im = tools.simulate(model, name + '_implicit', ['materials.bar.poisson_ratio=0', f'solver.end_time={nu_t}']
                                 + implicit_sets)
             b[f'nu_0_t_{nu_t:.4g}'] = {'explicit': sxx(ex), 'implicit_100a': sxx(im),
-                                       'explicit_nodes': nodal_sxx(ex), 'implicit_100a_nodes': nodal_sxx(im)}
+                                       'explicit_nodes': nodal_sxx(tools, ex), 'implicit_100a_nodes': nodal_sxx(tools, im)}
         results['bars'][problem] = b
 
     # Disks -----------------------------------------------------------------------------------

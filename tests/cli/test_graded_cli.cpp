@@ -75,6 +75,9 @@ TEST(GradedCli, ProfileAlongALine) {
   r = run(post + " profile " + file + " --field nope", dir);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("unknown field 'nope' (available: "), std::string::npos) << r.err;
+  r = run(post + " profile " + file + " --grid --field sigma", dir);  // graded: no single grid
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--grid: the run's grid is graded"), std::string::npos) << r.err;
   EXPECT_EQ(run(post + " profile --help", dir).status, 0);
 }
 

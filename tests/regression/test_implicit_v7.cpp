@@ -112,6 +112,18 @@ void bar(const std::string& name) {
     const auto [lo, hi] = std::minmax_element(nodal.begin(), nodal.end());
     for (double s : nodal) EXPECT_NEAR(s, expect, c.ref["nodal_tolerance"].value_or(0.0) * expect);
     EXPECT_LT((*hi - *lo) / expect, c.ref["nodal_spread"].value_or(0.0)) << "uniform along the bar";
+    // mpm-post profile --grid gives the same nodal values (the row y = 0.2, x = 0.4 ... 0.7).
+    const Result r = run(post + " profile " + c.stream.string() +
+                             " --grid --body bar --field sigma --component xx --from \"0.4 0.2\" "
+                             "--to \"0.7 0.2\" --radius 1e-6",
+                         c.dir);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto prof = csv(r.out);
+    ASSERT_EQ(prof.size(), 4u);
+    for (std::size_t k = 0; k < 4; ++k) {
+      EXPECT_NEAR(prof[k].at("s"), 0.1 * double(k), 1e-9);
+      EXPECT_NEAR(prof[k].at("value"), nodal[k], 1e-9 * std::abs(nodal[k]));
+    }
   }
   if (c.ref["thickness_tolerance"]) {  // plane stress: ln(h / h0) = eps_zz = -nu / E (s_xx + s_yy)
     const double E = c.ref["youngs_modulus"].value_or(0.0), nu = c.ref["poisson_ratio"].value_or(0.0);
