@@ -358,5 +358,32 @@ TEST(Materials, PlaneStressJ2UniaxialStressCurve) {
   uniaxial_stress_curve(true);
 }
 
+// The Rankine-Hugoniot state mpm-prep's time-step estimate uses. Mie-Grueneisen with the
+// Hugoniot as its reference curve: the shock of u_p into lead at rest has U_s = c0 + s u_p, so
+// rho_H = rho0 U_s / (U_s - u_p) exactly (V4: u_p = 3.29 km/s, 21 802 kg/m^3; a weak shock).
+// The signal speed behind it is above the unshocked one and grows with u_p.
+TEST(Materials, HugoniotStateOfTheShockEstimate) {
+  MaterialSpec lead;
+  lead.name = "lead";
+  lead.density = 11350;
+  lead.youngs_modulus = 22.4e9;
+  lead.poisson_ratio = 0.42;
+  lead.eos.model = EosModel::MieGruneisen;
+  lead.eos.c0 = 2092;
+  lead.eos.s = 1.45;
+  lead.eos.gamma0 = 2.0;
+  const Material mat(lead, SolverSpec{});
+  for (double u_p : {3290.0, 50.0}) {
+    const double Us = lead.eos.c0 + lead.eos.s * u_p;
+    const double rho_H = lead.density * Us / (Us - u_p);
+    EXPECT_NEAR(mat.hugoniot_density(u_p), rho_H, 1e-9 * rho_H) << "u_p " << u_p;
+  }
+  EXPECT_NEAR(mat.hugoniot_density(3290.0), 21802.5, 0.1);  // Shock.SymmetricLeadImpactMatchesRankineHugoniot
+  const double c0 = mat.reference_wave_speed();
+  EXPECT_EQ(mat.shocked_signal_speed(0.0), c0);
+  EXPECT_GT(mat.shocked_signal_speed(50.0), c0 + 50.0);
+  EXPECT_GT(mat.shocked_signal_speed(3290.0), mat.shocked_signal_speed(1000.0));
+}
+
 }  // namespace
 }  // namespace mpm

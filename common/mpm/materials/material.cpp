@@ -58,6 +58,39 @@ double Material::reference_wave_speed() const {
   return std::sqrt((K_ + 4.0 / 3.0 * G_) / spec_.density);
 }
 
+double Material::hugoniot_density(double u_p) const {
+  const double rho0 = spec_.density;
+  const double e = 0.5 * u_p * u_p;  // energy jump of a shock from rest
+  // f(rho) = p(rho, e) - rho0 U_s u_p rises from -inf at rho0+ (U_s -> inf); bisect for its
+  // root on (rho0, 20 rho0] (the EOS caps compression; a root beyond is no estimate anyway).
+  auto f = [&](double rho) {
+    double A, B, K;
+    eos_->coefficients(1, &rho, &A, &B, &K);
+    return A + B * e - rho0 * u_p * u_p * rho / (rho - rho0);
+  };
+  double lo = rho0 * (1 + 1e-12), hi = 20 * rho0;
+  if (!(u_p > 0) || f(hi) < 0) return 0.0;
+  for (int it = 0; it < 200 && hi - lo > 1e-13 * rho0; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (f(mid) < 0 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+double Material::shocked_signal_speed(double u_p) const {
+  if (!(u_p > 0)) return reference_wave_speed();
+  const double rho = hugoniot_density(u_p);
+  if (!(rho > 0)) return reference_wave_speed() + u_p;
+  const double e = 0.5 * u_p * u_p;
+  double A, B, K;
+  eos_->coefficients(1, &rho, &A, &B, &K);
+  const double p = A + B * e;
+  const double K_s = std::max(K, 0.0) + (p > 0 ? B * p / rho : 0.0);
+  const double c = std::sqrt((K_s + 4.0 / 3.0 * G_) / rho);
+  const double Q = bulk_linear_ * c + bulk_quadratic_ * u_p;
+  return Q + std::sqrt(Q * Q + c * c) + u_p;
+}
+
 void Material::update(MaterialBlock& b, BlockScratch& S) const {
   if (b.plane_stress)
     update_plane_stress(b, S);

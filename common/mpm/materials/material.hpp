@@ -97,6 +97,16 @@ class Material {
   static constexpr int kPlaneStressMaxPasses = 30;
   /// Signal speed (m/s) of the unstressed material: sqrt((K + 4G/3)/rho0).
   double reference_wave_speed() const;
+  /// Signal speed (m/s) behind a shock of particle velocity u_p (m/s) into the material at
+  /// rest, as the time step sees it: the Rankine-Hugoniot state of this
+  /// EOS (rho from p(rho, u_p^2 / 2) = rho0 U_s u_p, U_s = u_p rho / (rho - rho0)), its
+  /// isentropic sound speed, widened by the bulk viscosity with |tr D| = u_p / h (h cancels), plus u_p.
+  /// For estimates (mpm-prep); the reference speed when u_p = 0.
+  double shocked_signal_speed(double u_p) const;
+  /// Density (kg/m^3) of the Rankine-Hugoniot state of a shock of particle velocity u_p > 0
+  /// into the material at rest: the root of p(rho, u_p^2 / 2) = rho0 u_p^2 rho / (rho - rho0);
+  /// 0 if there is none below 20 rho0.
+  double hugoniot_density(double u_p) const;
 
  private:
   void update_once(MaterialBlock& blk, BlockScratch& S) const;
