@@ -245,6 +245,37 @@ TEST(Materials, SignalSpeedIsTheIsentropicSoundSpeed) {
   }
 }
 
+// A failed point carries no shear stress, and in expansion (pressure clamped at zero) no stress
+// at all: its signal speed has no shear term, and expanded far below rho0 it is the EOS's bulk
+// speed at rho0 (where waves start again on recompression), not sqrt(K / rho) of a density
+// a hundred times below it (V4's debris set the step that way: 21 km/s). Compressed, it is
+// the isentropic bulk speed sqrt(K_s / rho).
+TEST(Materials, FailedPointsSignalSpeedHasNoShearAndNoExpansionBlowUp) {
+  MaterialSpec spec = copper();
+  spec.eos = {EosModel::MieGruneisen, 3940.0, 1.49, 1.96};
+  spec.failure.pressure = -100e6;
+  const Material mat(spec, no_viscosity());
+  const double c_bulk0 = 3940.0;  // sqrt(K(rho0) / rho0) of this EOS: c0
+  for (const double ratio : {0.5, 0.01}) {
+    Point p(spec.density * ratio);
+    p.failed = 1;
+    p.update(mat, Mat3::Identity() * 1e2, 1e-9, false, true);  // expanding
+    EXPECT_EQ(p.sigma.norm(), 0.0);
+    EXPECT_NEAR(p.c, c_bulk0, 1e-6 * c_bulk0) << "rho / rho0 = " << ratio;
+  }
+  Point p(spec.density * 1.1);
+  p.failed = 1;
+  p.e = 1e5;
+  const double dt = 1e-9;
+  const Mat3 L = Mat3::Identity() * (-1e2 / 3.0);
+  p.update(mat, L, dt, false, true);
+  const double p1 = -trace(p.sigma) / 3, rho1 = p.rho;
+  p.update(mat, L, dt, false, true);
+  const double p2 = -trace(p.sigma) / 3, rho2 = p.rho;
+  const double c_s = std::sqrt(rho2 * (p2 - p1) / (rho2 - rho1) / rho2);
+  EXPECT_NEAR(p.c, c_s, 1e-4 * c_s) << "compressed: the bulk speed, no shear term";
+}
+
 TEST(Materials, FailureRemovesDeviatoricStressAndTension) {
   MaterialSpec spec = copper();
   spec.failure.plastic_strain = 0.05;

@@ -52,6 +52,8 @@ Material::Material(const MaterialSpec& spec, const SolverSpec& solver)
     throw std::logic_error("material '" + spec.name + "': model not registered");
   strength_ = s->second(spec);
   eos_ = e->second(spec);
+  double rho0 = spec.density, A, B;
+  eos_->coefficients(1, &rho0, &A, &B, &K0_eos_);
 }
 
 double Material::reference_wave_speed() const {
@@ -323,7 +325,15 @@ void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
     // and de = p / rho^2 drho, K_s = K + B p / rho (K = rho dA/drho from the EOS). The thermal
     // term matters behind strong shocks and in hot expanded material.
     const double K_s = std::max(S.K[i], 0.0) + (p > 0 ? S.B[i] * p / rho : 0.0);
-    const double c = std::sqrt((K_s + 4.0 / 3.0 * G_) / rho);
+    // A failed particle has no shear stiffness (s = 0), and with its pressure clamped at zero
+    // in expansion none at all: it moves ballistically until it is compressed back towards
+    // rho0, where waves start at the EOS's bulk speed there. Without this its G / rho and the
+    // EOS's floor under K made the expanding debris of V4 (rho ~ rho0 / 300) set the step
+    // with 21 km/s where no wave can run.
+    const bool failed_now = failure && b.failed[i];
+    double c2 = (K_s + (failed_now ? 0.0 : 4.0 / 3.0 * G_)) / rho;
+    if (failed_now && p <= 0 && q <= 0) c2 = std::min(c2, K0_eos_ / spec_.density);
+    const double c = std::sqrt(c2);
     const double Q = trD < 0 ? bulk_linear_ * c + bulk_quadratic_ * b.h * (-trD) : 0.0;
     b.c[i] = Q + std::sqrt(Q * Q + c * c);
     if (!std::isfinite(b.e[i]) || !sigma.allFinite() || !std::isfinite(rho)) {

@@ -114,6 +114,7 @@ class Material {
 
   MaterialSpec spec_;
   double G_ = 0, K_ = 0;
+  double K0_eos_ = 0;  ///< the EOS's bulk modulus at rho0, Pa
   double bulk_linear_ = 0, bulk_quadratic_ = 0;
   std::unique_ptr<Strength> strength_;
   std::unique_ptr<Eos> eos_;
