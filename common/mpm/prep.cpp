@@ -78,9 +78,12 @@ int prepare_model(const PrepOptions& opt) {
   // hypervelocity that is what sets the step (V4: twice the unshocked estimate).
   double speed = 0, speed_start = 0;
   {
+    std::vector<Material> materials;
     std::vector<double> c(scene.materials.size()), v_max(scene.materials.size(), 0.0);
-    for (std::size_t k = 0; k < c.size(); ++k)
-      c[k] = Material(scene.materials[k], scene.solver).reference_wave_speed();
+    for (std::size_t k = 0; k < c.size(); ++k) {
+      materials.emplace_back(scene.materials[k], scene.solver);
+      c[k] = materials[k].reference_wave_speed();
+    }
     const auto* mat = cols.get<std::uint8_t>(col::material);
     const auto* v = reinterpret_cast<const double*>(cols.at(col::v).data());
     const int d = scene.dimension;
@@ -96,8 +99,7 @@ int prepare_model(const PrepOptions& opt) {
     if (scene.solver.type == SolverType::Explicit)
       for (std::size_t k = 0; k < c.size(); ++k)
         if (v_max[k] > 0)
-          speed = std::max(speed, Material(scene.materials[k], scene.solver)
-                                      .shocked_signal_speed(0.5 * v_max[k]));
+          speed = std::max(speed, materials[k].shocked_signal_speed(0.5 * v_max[k]));
   }
   const double dt = std::min(scene.solver.dt_max, scene.solver.cfl * h_min / speed);
   const double steps = std::ceil(scene.solver.end_time / dt);

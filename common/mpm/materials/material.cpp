@@ -10,6 +10,18 @@
 
 namespace mpm {
 
+namespace {
+/// Isentropic bulk modulus of p = A(rho) + B e: K_s = rho dp/drho at constant entropy
+/// = K + B p / rho (K = rho dA/drho from the EOS; de = p / rho^2 drho). The thermal term
+/// matters behind strong shocks and in hot expanded material.
+double isentropic_bulk(double K, double B, double p, double rho) {
+  return std::max(K, 0.0) + (p > 0 ? B * p / rho : 0.0);
+}
+/// The signal speed the time step uses: sound speed c widened by the bulk viscosity, as in
+/// hydrocodes: dt <= h / (Q + sqrt(Q^2 + c^2)), Q = C1 c + C0 h |tr D| in compression.
+double widened(double c, double Q) { return Q + std::sqrt(Q * Q + c * c); }
+}  // namespace
+
 std::string to_string(StrengthModel m) {
   switch (m) {
     case StrengthModel::Elastic: return "elastic";
@@ -86,11 +98,8 @@ double Material::shocked_signal_speed(double u_p) const {
   const double e = 0.5 * u_p * u_p;
   double A, B, K;
   eos_->coefficients(1, &rho, &A, &B, &K);
-  const double p = A + B * e;
-  const double K_s = std::max(K, 0.0) + (p > 0 ? B * p / rho : 0.0);
-  const double c = std::sqrt((K_s + 4.0 / 3.0 * G_) / rho);
-  const double Q = bulk_linear_ * c + bulk_quadratic_ * u_p;
-  return Q + std::sqrt(Q * Q + c * c) + u_p;
+  const double c = std::sqrt((isentropic_bulk(K, B, A + B * e, rho) + 4.0 / 3.0 * G_) / rho);
+  return widened(c, bulk_linear_ * c + bulk_quadratic_ * u_p) + u_p;
 }
 
 void Material::update(MaterialBlock& b, BlockScratch& S) const {
@@ -105,9 +114,9 @@ void Material::update(MaterialBlock& b, BlockScratch& S) const {
 // particle's root is found from the elastic estimate by Newton steps with the elastic slope,
 // then secant steps, until the root is bracketed, and inside the bracket by the Illinois
 // variant of false position (superlinear also where sigma_zz(d) has kinks: yield, the bulk
-// viscosity switching on in compression, failure). Every pass runs the whole block's update
-// from the saved state of t^n, so the strength model, the EOS, the bulk viscosity and failure
-// need no plane-stress variant of their own.
+// viscosity switching on in compression, failure). Every evaluation runs the whole update from
+// the saved state of t^n, so the strength model, the EOS, the bulk viscosity and failure need
+// no plane-stress variant of their own.
 void Material::update_plane_stress(MaterialBlock& b, BlockScratch& S) const {
   const int n = b.n;
   Sym sigma0[kBlock];
@@ -319,12 +328,8 @@ void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
     sigma[1] -= p + q;
     sigma[2] -= p + q;
     b.sigma[i] = sigma;
-    // Signal speed for the time step, widened by the viscosity as in hydrocodes:
-    // dt <= h / (Q + sqrt(Q^2 + c^2)), Q = C1 c + C0 h |tr D| in compression.
-    // Isentropic bulk modulus K_s = rho dp/drho at constant entropy: with p = A(rho) + B e
-    // and de = p / rho^2 drho, K_s = K + B p / rho (K = rho dA/drho from the EOS). The thermal
-    // term matters behind strong shocks and in hot expanded material.
-    const double K_s = std::max(S.K[i], 0.0) + (p > 0 ? S.B[i] * p / rho : 0.0);
+    // Signal speed for the time step: the isentropic sound speed, widened by the viscosity.
+    const double K_s = isentropic_bulk(S.K[i], S.B[i], p, rho);
     // A failed particle has no shear stiffness (s = 0), and with its pressure clamped at zero
     // in expansion none at all: it moves ballistically until it is compressed back towards
     // rho0, where waves start at the EOS's bulk speed there. Without this its G / rho and the
@@ -335,7 +340,7 @@ void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
     if (failed_now && p <= 0 && q <= 0) c2 = std::min(c2, K0_eos_ / spec_.density);
     const double c = std::sqrt(c2);
     const double Q = trD < 0 ? bulk_linear_ * c + bulk_quadratic_ * b.h * (-trD) : 0.0;
-    b.c[i] = Q + std::sqrt(Q * Q + c * c);
+    b.c[i] = widened(c, Q);
     if (!std::isfinite(b.e[i]) || !sigma.allFinite() || !std::isfinite(rho)) {
       if (b.fault_index < 0) b.fault_index = i, b.fault = PointFault::NonFinite;
     }

@@ -91,9 +91,11 @@ class Material {
   /// Constitutive update of one block (000, eqs. 12-15; Jaumann rate, radial return, EOS with
   /// internal energy, artificial bulk viscosity, failure). `S` is per-thread scratch. With
   /// `blk.plane_stress` the out-of-plane rate is solved for, per particle, by a safeguarded
-  /// secant iteration on sigma_zz = 0 around the whole update (any strength, EOS and failure).
+  /// secant / false-position iteration on sigma_zz = 0 around the whole update (any strength,
+  /// EOS and failure).
   void update(MaterialBlock& blk, BlockScratch& S) const;
-  /// Cap on the update passes of a plane-stress block (each pass updates the whole block).
+  /// Cap on the update passes of a plane-stress block (the first updates the whole block, the
+  /// later ones the particles still iterating).
   static constexpr int kPlaneStressMaxPasses = 30;
   /// Signal speed (m/s) of the unstressed material: sqrt((K + 4G/3)/rho0).
   double reference_wave_speed() const;
