@@ -76,6 +76,17 @@ bool rigid_body_velocities(const Scene& scene, std::vector<Vec<D>>& velocity) {
   return any;
 }
 
+/// The velocity components each rigid body imposes on the nodes it touches, as bits (bit a:
+/// axis a): all of them for no-slip contact, the others than its `slip` axes otherwise.
+template <int D>
+std::vector<std::uint8_t> rigid_body_held(const Scene& scene) {
+  constexpr std::uint8_t all = (1u << D) - 1;
+  std::vector<std::uint8_t> held(scene.bodies.size(), 0);
+  for (std::size_t b = 0; b < scene.bodies.size(); ++b)
+    if (scene.bodies[b].rigid) held[b] = std::uint8_t(all & ~scene.bodies[b].slip_axes);
+  return held;
+}
+
 /// Checks that every particle starts inside the grid's domain (InputError naming the first
 /// that does not) and returns the nodal-mass floor below which a node counts as empty: 1e-14
 /// of the lightest deformable particle.
@@ -245,6 +256,7 @@ class ExplicitSolver {
   bool plane_stress_ = false;  ///< 2D: sigma_zz = 0 (the material update solves for L_zz)
   bool has_rigid_ = false;
   std::vector<Vec<D>> rigid_velocity_;  ///< by body; zero for deformable bodies
+  std::vector<std::uint8_t> rigid_held_;  ///< by body: the components it imposes (bits)
   std::vector<Vec3> rigid_force_;
   Vec<D> gravity_ = Vec<D>::Zero();
   double cfl_, dt_max_;

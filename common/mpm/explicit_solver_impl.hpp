@@ -94,6 +94,7 @@ ExplicitSolver<GridT>::ExplicitSolver(const Scene& scene, GridT grid, ColumnStor
   for (const auto& m : scene_.materials) materials_.emplace_back(m, scene_.solver);
   for (int a = 0; a < D; ++a) gravity_[a] = scene_.solver.gravity[a];
   has_rigid_ = rigid_body_velocities<D>(scene_, rigid_velocity_);
+  rigid_held_ = rigid_body_held<D>(scene_);
   rigid_force_.assign(scene_.bodies.size(), Vec3::Zero());
   const int threads = omp_get_max_threads();
   if (strategy_ == ScatterStrategy::LRSlabs) binning_.target_chunks = 2 * threads;
@@ -368,7 +369,7 @@ void ExplicitSolver<GridT>::scatter(int fields, BinBody&& bin_body, ParticleBody
   }
 }
 
-// Rigid particles mark the nodes they touch with their body (no-slip contact), serially:
+// Rigid particles mark the nodes they touch with their body, serially:
 // they are few, and a node touched by two rigid bodies then takes the later one's mark.
 template <class GridT>
 void ExplicitSolver<GridT>::mark_rigid_nodes() {
@@ -490,8 +491,9 @@ void ExplicitSolver<GridT>::p2g() {
 
 // ------------------------------------------------------------------------------------------
 // Grid kernels: nodal velocities and accelerations, boundary conditions (000, eq. 6), rigid
-// bodies (no-slip: the nodes they touch take their velocity; the force that takes is the
-// force between material and body).
+// bodies (the nodes they touch take their velocity, in every component for no-slip contact,
+// in the components other than the `slip` axes otherwise; the force that takes is the force
+// between material and body).
 
 template <class GridT>
 void ExplicitSolver<GridT>::apply_boundary(std::vector<Vec<D>>& vel, std::vector<Vec<D>>* acc,
@@ -524,13 +526,17 @@ void ExplicitSolver<GridT>::apply_boundary(std::vector<Vec<D>>& vel, std::vector
     const int mark = grid_.rigid[i];
     if (mark == 0 || grid_.m[i] <= node_mass_floor_) continue;
     const Vec<D>& vb = rigid_velocity_[mark - 1];
-    if (record_force) {
-      const Vec<D> F = grid_.m[i] * (vel[i] - vb) / dt_;  // what the body must push back
-      for (int a = 0; a < D; ++a) rigid_force_[mark - 1][a] += F[a];
-      balance_.external_work -= dt_ * F.dot(vb);  // work of the body on the material
+    const std::uint8_t held = rigid_held_[mark - 1];  // the other components slip
+    for (int a = 0; a < D; ++a) {
+      if (!(held >> a & 1)) continue;
+      if (record_force) {
+        const double F = grid_.m[i] * (vel[i][a] - vb[a]) / dt_;  // what the body pushes back
+        rigid_force_[mark - 1][a] += F;
+        balance_.external_work -= dt_ * F * vb[a];  // work of the body on the material
+      }
+      if (acc) (*acc)[i][a] += (vb[a] - vel[i][a]) / dt_;
+      vel[i][a] = vb[a];
     }
-    if (acc) (*acc)[i] += (vb - vel[i]) / dt_;
-    vel[i] = vb;
   }
 }
 

@@ -586,7 +586,8 @@ bool valid_name(std::string_view s) {
 
 const std::vector<std::string_view> kBodyKeys = {
     "name", "material", "shape",  "size",      "radius",   "length",
-    "file", "scale",    "rotate", "translate", "velocity", "particles_per_cell", "rigid"};
+    "file", "scale",    "rotate", "translate", "velocity", "particles_per_cell", "rigid",
+    "slip"};
 
 BodySpec read_body(Reader& r, const Scene& scene) {
   const int n = scene.dimension;
@@ -686,6 +687,25 @@ BodySpec read_body(Reader& r, const Scene& scene) {
   if (auto v = r.vector("translate", dim::length, n)) b.translate = *v;
   if (auto v = r.vector("velocity", dim::velocity, n)) b.velocity = *v;
   b.particles_per_cell = static_cast<int>(r.integer("particles_per_cell", 1, 8).value_or(2));
+  if (auto slip = r.string("slip")) {
+    // The axes along which a rigid body's contact is frictionless: "y", "x z", "xz"; "none":
+    // no-slip (the default, for --set).
+    const std::string axes = two_d ? "x y" : "x y z";
+    if (!b.rigid)
+      r.fail("slip", "only a rigid body has a contact to slip on (this body has a material)");
+    for (char c : *slip == "none" ? std::string() : *slip) {
+      if (c == ' ' || c == ',') continue;
+      const int a = c - 'x';
+      if (a < 0 || a >= n)
+        r.fail("slip", "expected the axes along which the contact is frictionless, from " + axes +
+                           ", e.g. \"y\"; got '" + std::string(1, c) + "' in \"" + *slip + "\"");
+      b.slip_axes |= std::uint8_t(1u << a);
+    }
+    if (b.slip_axes == 0 && *slip != "none")
+      r.fail("slip", "expected at least one axis from " + axes + ", e.g. \"y\", or \"none\"");
+    if (b.slip_axes == (1u << n) - 1)
+      r.fail("slip", "a body that slips along every axis holds nothing; leave one axis out");
+  }
   r.finish();
   return b;
 }

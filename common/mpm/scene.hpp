@@ -90,7 +90,10 @@ struct BodySpec {
   Vec3 translate = Vec3::Zero(); ///< applied last, m
   Vec3 velocity = Vec3::Zero();  ///< initial velocity, m/s (rigid bodies: kept for ever)
   int particles_per_cell = 2;    ///< per axis: n x n x n particles in each cell
-  bool rigid = false;            ///< moves at `velocity` whatever happens; no-slip contact
+  bool rigid = false;            ///< moves at `velocity` whatever happens
+  /// Rigid bodies: bit a set = the contact is frictionless along axis a (the nodes the body
+  /// touches keep the material's velocity in that component); 0 = no-slip (all components).
+  std::uint8_t slip_axes = 0;
   SourceLoc loc;
 };
 

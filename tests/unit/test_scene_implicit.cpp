@@ -2,6 +2,7 @@
 // reported with file, line and key.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 
 #include "mpm/error.hpp"
@@ -149,6 +150,58 @@ TEST(SceneImplicit, MistakesNameFileLineAndKey) {
   // Through --set the override is named.
   const std::string msg = error("type = \"implicit\"\n", {"solver.implicit.theta=2"});
   EXPECT_NE(msg.find("--set solver.implicit.theta"), std::string::npos) << msg;
+}
+
+// A rigid body's contact: no-slip by default, frictionless along the `slip` axes.
+TEST(SceneImplicit, RigidBodySlipAxes) {
+  const std::string puller = R"(
+[[bodies]]
+name = "puller"
+rigid = true
+shape = "box"
+size = "0.1 0.3"
+velocity = "-0.001 0"
+)";
+  // The [solver] table ends kScene, so the body goes before it.
+  auto scene = [&](const std::string& body_extra) {
+    std::string text = kScene;
+    text.insert(text.find("[grid]"), puller + body_extra + "\n");
+    return text;
+  };
+  auto parse_text = [](const std::string& text, const std::vector<std::string>& sets = {}) {
+    return parse_scene(text, "bar.toml", "/scenes", sets);
+  };
+  EXPECT_EQ(parse_text(scene("")).bodies[1].slip_axes, 0);
+  EXPECT_EQ(parse_text(scene("slip = \"y\"")).bodies[1].slip_axes, 2);
+  EXPECT_EQ(parse_text(scene("slip = \"y\""), {"bodies.puller.slip=none"}).bodies[1].slip_axes, 0);
+  EXPECT_EQ(parse_text(scene(""), {"bodies.puller.slip=x"}).bodies[1].slip_axes, 1);
+  auto fails = [&](const std::string& extra, const std::string& says) {
+    const std::string text = scene(extra);
+    try {
+      parse_text(text);
+      ADD_FAILURE() << "no InputError for " << extra;
+    } catch (const InputError& e) {
+      const std::string line = std::to_string(
+          std::count(text.begin(), text.begin() + text.find(extra), '\n') + 1);
+      EXPECT_EQ(std::string(e.what()), "bar.toml:" + line + ": bodies.puller.slip: " + says) << extra;
+    }
+  };
+  fails("slip = \"z\"", "expected the axes along which the contact is frictionless, from x y, "
+                        "e.g. \"y\"; got 'z' in \"z\"");
+  fails("slip = \"x y\"", "a body that slips along every axis holds nothing; leave one axis out");
+  fails("slip = \"\"", "expected at least one axis from x y, e.g. \"y\", or \"none\"");
+  // On a deformable body.
+  std::string text = kScene;
+  text.insert(text.find("\n[grid]"), "slip = \"y\"\n");
+  try {
+    parse_text(text);
+    ADD_FAILURE() << "no InputError for slip on a deformable body";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "slip: only a rigid body has a contact to slip on (this body has a material)"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

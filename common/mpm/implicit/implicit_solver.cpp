@@ -156,6 +156,7 @@ ImplicitSolver<GridT>::ImplicitSolver(const Scene& scene, GridT grid, ColumnStor
   }
   for (int a = 0; a < D; ++a) gravity_[a] = scene_.solver.gravity[a];
   has_rigid_ = rigid_body_velocities<D>(scene_, rigid_velocity_);
+  rigid_held_ = rigid_body_held<D>(scene_);
   rigid_force_.assign(scene_.bodies.size(), Vec3::Zero());
   const int threads = omp_get_max_threads();
   scratch_.resize(threads);
@@ -313,8 +314,9 @@ void ImplicitSolver<GridT>::p2g() {
 // ------------------------------------------------------------------------------------------
 // The unknowns: every velocity (or momentum) component of every node with mass, except the
 // prescribed ones (001, section 2.4.1: nodes with displacement conditions are excluded):
-// fixed faces (all components), slip faces (the normal one), nodes a rigid body touches (all,
-// at the body's velocity: no-slip, as in the explicit solver).
+// fixed faces (all components), slip faces (the normal one), nodes a rigid body touches (at
+// the body's velocity: all components for no-slip contact, the others than its `slip` axes
+// otherwise, as in the explicit solver).
 
 template <class GridT>
 void ImplicitSolver<GridT>::free_dofs() {
@@ -329,9 +331,12 @@ void ImplicitSolver<GridT>::free_dofs() {
   if (has_rigid_)
     for (std::size_t n = 0; n < nodes; ++n)
       if (grid_.rigid[n] && grid_.m[n] > node_mass_floor_) {
-        held_[n] = all;
-        face_held_[n] = 0;
-        v_bc_[n] = rigid_velocity_[grid_.rigid[n] - 1];
+        const std::uint8_t body = rigid_held_[grid_.rigid[n] - 1];
+        held_[n] |= body;
+        face_held_[n] &= std::uint8_t(~body);  // the body takes these components' force
+        const Vec<D>& vb = rigid_velocity_[grid_.rigid[n] - 1];
+        for (int a = 0; a < D; ++a)
+          if (body >> a & 1) v_bc_[n][a] = vb[a];
       }
   dof_node_.clear();
   dof_axis_.clear();
@@ -690,9 +695,9 @@ void ImplicitSolver<GridT>::reactions(const nk::Vector& u) {
   };
   face_force_.fill(0.0);
   auto record = [&](std::int64_t n, int face) {
-    if (has_rigid_ && grid_.rigid[n] && grid_.m[n] > node_mass_floor_) return;  // the body's
     if (!(grid_.m[n] > node_mass_floor_)) return;
     const int axis = face / 2;
+    if (!(face_held_[n] >> axis & 1)) return;  // a rigid body holds this component: its force
     const double sign = (face % 2 == 0) ? -1.0 : 1.0;
     face_force_[face] += sign * force_on_support(n)[axis];
   };
@@ -705,8 +710,12 @@ void ImplicitSolver<GridT>::reactions(const nk::Vector& u) {
     const int mark = grid_.rigid[n];
     if (mark == 0 || !(grid_.m[n] > node_mass_floor_)) continue;
     const Vec<D> F = force_on_support(n);
-    for (int a = 0; a < D; ++a) rigid_force_[mark - 1][a] += F[a];
-    balance_.external_work -= dt * F.dot(rigid_velocity_[mark - 1]);
+    const std::uint8_t held = rigid_held_[mark - 1];  // the other components slip
+    for (int a = 0; a < D; ++a)
+      if (held >> a & 1) {
+        rigid_force_[mark - 1][a] += F[a];
+        balance_.external_work -= dt * F[a] * rigid_velocity_[mark - 1][a];
+      }
   }
 }
 

@@ -141,6 +141,7 @@ class ImplicitSolver {
   std::vector<Material> materials_;
   bool axisymmetric_ = false, plane_stress_ = false, has_rigid_ = false;
   std::vector<Vec<D>> rigid_velocity_;
+  std::vector<std::uint8_t> rigid_held_;  ///< by body: the components it imposes (bits)
   std::vector<Vec3> rigid_force_;
   Vec<D> gravity_ = Vec<D>::Zero();
   double dt_explicit_ = 0, next_dt_ = 0, dt_ = 0, last_dt_ = 0, time_ = 0;
