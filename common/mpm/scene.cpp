@@ -979,6 +979,10 @@ void read_implicit(Reader& r, ImplicitSpec& m) {
                           {{"none", Preconditioner::None}, {"diagonal", Preconditioner::Diagonal}})
                          .value_or(m.formulation == Formulation::Velocity ? Preconditioner::Diagonal
                                                                           : Preconditioner::None);
+  m.initial_guess = r.choice<InitialGuess>("initial_guess", {{"particles", InitialGuess::Particles},
+                                                             {"previous", InitialGuess::Previous}})
+                        .value_or(m.formulation == Formulation::Velocity ? InitialGuess::Previous
+                                                                         : InitialGuess::Particles);
   r.finish();
 }
 
@@ -991,7 +995,7 @@ void read_solver(Reader& r, Scene& s) {
           "implicit", {"theta", "formulation", "krylov", "newton_tolerance", "linear_tolerance",
                        "derivative_step", "gmres_basis", "gmres_restarts", "max_krylov",
                        "max_newton", "max_line_search", "dt_initial_multiple", "dt_target_multiple",
-                       "ramp", "cut", "max_cuts", "forcing", "preconditioner"})) {
+                       "ramp", "cut", "max_cuts", "forcing", "preconditioner", "initial_guess"})) {
     if (v.type != SolverType::Implicit)
       r.fail("implicit", "is used only with solver.type = \"implicit\"");
     read_implicit(*t, v.implicit);

@@ -158,6 +158,9 @@ enum class Formulation { Velocity, Momentum };
 enum class KrylovMethod { CG, GMRES };
 /// Linear tolerance of each Newton step: fixed, or Eisenstat-Walker (choice 2).
 enum class Forcing { Fixed, EisenstatWalker };
+/// Newton's initial guess: the grid velocities (or momenta) from the particles, v^k (001,
+/// Algorithm 1), or the previous step's converged grid velocities where a node had them.
+enum class InitialGuess { Particles, Previous };
 /// Preconditioner of the Krylov solve: none, or the Jacobian's diagonal estimated from the
 /// lumped mass and the elastic stiffness.
 enum class Preconditioner { None, Diagonal };
@@ -185,6 +188,9 @@ struct ImplicitSpec {
   /// Default by measurement too: diagonal for the velocity formulation (CG), none for the
   /// momentum formulation (GMRES), where the elastic diagonal slowed the plastic upsetting.
   Preconditioner preconditioner = Preconditioner::None;
+  /// Default by measurement: previous for the velocity formulation (CG), particles for the
+  /// momentum formulation (GMRES), where the contact of the upsetting made it slower.
+  InitialGuess initial_guess = InitialGuess::Particles;
 };
 
 struct SolverSpec {

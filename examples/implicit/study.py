@@ -330,7 +330,8 @@ def study(tools, quick):
     results['upsetting'] = u
 
     # Options: forcing x preconditioner, residual evaluations --------------------------------
-    md.append('### Options: forcing terms and preconditioner (residual evaluations, wall s)')
+    md.append('### Options: forcing terms and preconditioner (residual evaluations, wall s; '
+              'initial guess: the default of the formulation)')
     md.append('')
     md.append('| problem | solver | multiple | fixed, none | fixed, diagonal | EW, none | EW, diagonal |')
     md.append('|---|---|---|---|---|---|---|')
@@ -353,6 +354,31 @@ def study(tools, quick):
                 cells.append(f'{int(r["evals"])}, {fmt(r["wall"], 3)}' if r['status'] == 0 else 'failed')
                 results['options'].append({'problem': problem, 'solver': solver, 'multiple': mult, 'forcing': forcing,
                                            'preconditioner': pc, 'evals': r.get('evals'), 'wall': r.get('wall')})
+        md.append(f'| {problem} | {solver} | {mult} | ' + ' | '.join(cells) + ' |')
+    md.append('')
+
+    # Options: Newton's initial guess, with the default forcing and preconditioner ------------
+    md.append('### Options: Newton\'s initial guess (residual evaluations, wall s; default forcing and '
+              'preconditioner)')
+    md.append('')
+    md.append('| problem | solver | multiple | particles (v^k) | previous (v^L of the last step) |')
+    md.append('|---|---|---|---|---|')
+    guess_cases = [('elastic_bar', 'cg', 10), ('plastic_bar', 'cg', 10), ('plastic_bar', 'gmres', 10)] + option_cases
+    for problem, solver, mult in guess_cases:
+        model = os.path.join(OUT, problem + '.model')
+        newton, linear = TOL[problem]
+        initial = mult if problem == 'upsetting' else 1
+        cells = []
+        for guess in ('particles', 'previous'):
+            sets = ['solver.type=implicit', f'solver.implicit.formulation={"velocity" if solver == "cg" else "momentum"}',
+                    f'solver.implicit.newton_tolerance={newton}', f'solver.implicit.linear_tolerance={linear}',
+                    f'solver.implicit.dt_initial_multiple={initial}', f'solver.implicit.dt_target_multiple={mult}',
+                    f'solver.implicit.initial_guess={guess}']
+            r = tools.simulate(model, f'guess_{problem}_{solver}_{mult}_{guess}', sets,
+                               repeat=3 if problem != 'upsetting' or mult >= 1000 else 1)
+            cells.append(f'{int(r["evals"])}, {fmt(r["wall"], 3)}' if r['status'] == 0 else 'failed')
+            results['options'].append({'problem': problem, 'solver': solver, 'multiple': mult, 'initial_guess': guess,
+                                       'evals': r.get('evals'), 'wall': r.get('wall')})
         md.append(f'| {problem} | {solver} | {mult} | ' + ' | '.join(cells) + ' |')
     md.append('')
 

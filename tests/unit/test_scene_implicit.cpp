@@ -64,9 +64,11 @@ TEST(SceneImplicit, DefaultsAreTheSeeds) {
   EXPECT_EQ(m.dt_initial_multiple, 1.0);
   EXPECT_EQ(m.forcing, Forcing::EisenstatWalker);     // beyond the seed: measured to win
   EXPECT_EQ(m.preconditioner, Preconditioner::None);  // with GMRES: measured to lose
+  EXPECT_EQ(m.initial_guess, InitialGuess::Particles);  // the seed's v^k: with GMRES, wins
   const Scene v = parse("type = \"implicit\"\n", {"solver.implicit.formulation=velocity"});
   EXPECT_EQ(v.solver.implicit.krylov, KrylovMethod::CG);
   EXPECT_EQ(v.solver.implicit.preconditioner, Preconditioner::Diagonal);  // with CG: wins
+  EXPECT_EQ(v.solver.implicit.initial_guess, InitialGuess::Previous);       // with CG: wins
 }
 
 TEST(SceneImplicit, EveryKeyIsRead) {
@@ -89,6 +91,7 @@ cut = 0.25
 max_cuts = 3
 forcing = "fixed"
 preconditioner = "none"
+initial_guess = "particles"
 )");
   const ImplicitSpec& m = s.solver.implicit;
   EXPECT_EQ(m.theta, 0.5);
@@ -109,6 +112,7 @@ preconditioner = "none"
   EXPECT_EQ(m.max_cuts, 3);
   EXPECT_EQ(m.forcing, Forcing::Fixed);
   EXPECT_EQ(m.preconditioner, Preconditioner::None);
+  EXPECT_EQ(m.initial_guess, InitialGuess::Particles);  // not the velocity formulation's default
   // Velocity formulation with GMRES is allowed; --set reaches the table.
   const Scene g = parse("type = \"implicit\"\n",
                         {"solver.implicit.formulation=velocity", "solver.implicit.krylov=gmres"});
@@ -137,6 +141,8 @@ TEST(SceneImplicit, MistakesNameFileLineAndKey) {
       {imp + "cut = 1\n", "bar.toml:23: solver.implicit.cut: must be below 1"},
       {imp + "forcing = \"ew\"\n",
        "bar.toml:23: solver.implicit.forcing: expected one of \"fixed\", \"eisenstat-walker\""},
+      {imp + "initial_guess = \"last\"\n",
+       "bar.toml:23: solver.implicit.initial_guess: expected one of \"particles\", \"previous\""},
       {"[solver.implicit]\ntheta = 1\n",
        "solver.implicit: is used only with solver.type = \"implicit\""},
       {"type = \"implicit\"\nscheme = \"USL\"\n",

@@ -38,6 +38,7 @@ void ImplicitSolver<GridT>::step(double dt) {
     ++last_work_.step_cuts;
   }
   reactions(u_);  // forces on rigid bodies and constrained faces
+  if (spec_.initial_guess == InitialGuess::Previous) remember(u_);
   commit(u_);     // v_p, x_p (001, eqs. 2.3.2-2.3.3 or 3.2.5-3.2.6), stress state (eq. 2.3.6)
   // Step control (001, Tables 1-6): ramp the planned step by `ramp` up to the target.
   const double base = last_work_.step_cuts > 0 ? h : std::max(h, next_dt_);
@@ -409,11 +410,28 @@ nk::NonlinearSystem& ImplicitSolver<GridT>::system_for_current(double dt, nk::Ve
   const bool momentum = spec_.formulation == Formulation::Momentum;
   const std::size_t nd = dof_node_.size();
   const double scale = residual_scale(dt);
-  // Initial guess v^k (or P^k) at the free components (001, Algorithm 1, step 1).
+  // Initial guess v^k (or P^k) at the free components (001, Algorithm 1, step 1); with
+  // initial_guess = "previous", the last step's v^L (m_i v^L) where the node had it with a
+  // mass within a factor 2 of its mass now (a node the material has just reached, or nearly
+  // left, keeps v^k: there v^L of the last step says little, and m_i v^L could be far off).
   u0.resize(Eigen::Index(nd));
+  const bool warm = spec_.initial_guess == InitialGuess::Previous && !previous_.empty();
+  std::int64_t warm_node = -1;
+  const std::pair<double, Vec<D>>* last = nullptr;
   for (std::size_t d = 0; d < nd; ++d) {
     const std::int64_t n = dof_node_[d];
-    u0[d] = momentum ? P_k_[n][dof_axis_[d]] : v_k_[n][dof_axis_[d]];
+    const int a = dof_axis_[d];
+    u0[d] = momentum ? P_k_[n][a] : v_k_[n][a];
+    if (!warm) continue;
+    if (n != warm_node) {
+      warm_node = n;
+      const auto it = previous_.find(global_key(n));
+      const double m = grid_.m[n];
+      last = it != previous_.end() && it->second.first <= 2 * m && m <= 2 * it->second.first
+                 ? &it->second
+                 : nullptr;
+    }
+    if (last) u0[d] = momentum ? grid_.m[n] * last->second[a] : last->second[a];
   }
   // Typical size of u for the directional difference: the largest speed of the particles
   // and rigid bodies on every unknown (an explicit acceleration dt f_i / m_i is no measure:
@@ -443,6 +461,31 @@ nk::NonlinearSystem& ImplicitSolver<GridT>::system_for_current(double dt, nk::Ve
     }
   }
   return *system_;
+}
+
+/// A node's index in the lattice (the whole domain), which survives refits of the window.
+template <class GridT>
+std::int64_t ImplicitSolver<GridT>::global_key(std::int64_t node) const {
+  const IVec<D> g = grid_.global_node(node);
+  std::int64_t k = 0;
+  for (int a = D - 1; a >= 0; --a) k = (k << 21) + g[a];
+  return k;
+}
+
+/// Keeps the accepted step's grid velocities (prescribed ones included) and masses for the
+/// next step's initial guess.
+template <class GridT>
+void ImplicitSolver<GridT>::remember(const nk::Vector& u) {
+  const bool momentum = spec_.formulation == Formulation::Momentum;
+  std::vector<Vec<D>> w;
+  to_grid(u, w);
+  previous_.clear();
+  const std::size_t nodes = grid_.nodes();
+  for (std::size_t n = 0; n < nodes; ++n) {
+    const double m = grid_.m[n];
+    if (!(m > node_mass_floor_)) continue;
+    previous_[global_key(std::int64_t(n))] = {m, momentum ? Vec<D>(w[n] / m) : w[n]};
+  }
 }
 
 // ------------------------------------------------------------------------------------------

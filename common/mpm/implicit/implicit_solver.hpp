@@ -12,6 +12,7 @@
 /// formulation USL, step for step.
 #include <array>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include "mpm/binning.hpp"
@@ -172,6 +173,11 @@ class ImplicitSolver {
   std::vector<double> N_p_;              ///< shape functions at x_p^k, NMAX per particle
   std::vector<Vec<D>> G_p_;              ///< their gradients, 1/m
   double u_typ_ = 0;
+  /// The last accepted step's grid velocities v_i^L and masses, by global node (for
+  /// initial_guess = "previous"; node indices change when the window is refitted).
+  std::unordered_map<std::int64_t, std::pair<double, Vec<D>>> previous_;
+  std::int64_t global_key(std::int64_t node) const;
+  void remember(const nk::Vector& u);
   nk::Vector inv_diag_;
   nk::Vector u_;  ///< the converged unknowns
   std::unique_ptr<Trial> trial_, accepted_;
