@@ -338,22 +338,26 @@ def study(tools, quick):
     option_cases = [('elastic_bar', 'gmres', 100), ('elastic_bar', 'cg', 100), ('plastic_bar', 'gmres', 100),
                     ('plastic_bar', 'cg', 100), ('disks', 'cg', 10), ('disks', 'cg', 100),
                     ('upsetting', 'gmres', 100), ('upsetting', 'gmres', 1000), ('upsetting', 'gmres', 10000)]
-    for problem, solver, mult in option_cases:
-        model = os.path.join(OUT, problem + '.model')
+
+    def option_run(problem, solver, mult, options):
+        """One option case with the study's tolerances and steps; `options` maps keys of
+        [solver.implicit] to values. Returns the table cell and records the run."""
         newton, linear = TOL[problem]
         initial = mult if problem == 'upsetting' else 1
-        cells = []
-        for forcing in ('fixed', 'eisenstat-walker'):
-            for pc in ('none', 'diagonal'):
-                sets = ['solver.type=implicit', f'solver.implicit.formulation={"velocity" if solver == "cg" else "momentum"}',
-                        f'solver.implicit.newton_tolerance={newton}', f'solver.implicit.linear_tolerance={linear}',
-                        f'solver.implicit.dt_initial_multiple={initial}', f'solver.implicit.dt_target_multiple={mult}',
-                        f'solver.implicit.forcing={forcing}', f'solver.implicit.preconditioner={pc}']
-                r = tools.simulate(model, f'opt_{problem}_{solver}_{mult}_{forcing}_{pc}', sets,
-                                   repeat=3 if problem != 'upsetting' or mult >= 1000 else 1)
-                cells.append(f'{int(r["evals"])}, {fmt(r["wall"], 3)}' if r['status'] == 0 else 'failed')
-                results['options'].append({'problem': problem, 'solver': solver, 'multiple': mult, 'forcing': forcing,
-                                           'preconditioner': pc, 'evals': r.get('evals'), 'wall': r.get('wall')})
+        sets = ['solver.type=implicit', f'solver.implicit.formulation={"velocity" if solver == "cg" else "momentum"}',
+                f'solver.implicit.newton_tolerance={newton}', f'solver.implicit.linear_tolerance={linear}',
+                f'solver.implicit.dt_initial_multiple={initial}', f'solver.implicit.dt_target_multiple={mult}']
+        sets += [f'solver.implicit.{k}={v}' for k, v in options.items()]
+        r = tools.simulate(os.path.join(OUT, problem + '.model'),
+                           f'opt_{problem}_{solver}_{mult}_' + '_'.join(options.values()), sets,
+                           repeat=3 if problem != 'upsetting' or mult >= 1000 else 1)
+        results['options'].append({'problem': problem, 'solver': solver, 'multiple': mult, **options,
+                                   'evals': r.get('evals'), 'wall': r.get('wall')})
+        return f'{int(r["evals"])}, {fmt(r["wall"], 3)}' if r['status'] == 0 else 'failed'
+
+    for problem, solver, mult in option_cases:
+        cells = [option_run(problem, solver, mult, {'forcing': forcing, 'preconditioner': pc})
+                 for forcing in ('fixed', 'eisenstat-walker') for pc in ('none', 'diagonal')]
         md.append(f'| {problem} | {solver} | {mult} | ' + ' | '.join(cells) + ' |')
     md.append('')
 
@@ -365,20 +369,7 @@ def study(tools, quick):
     md.append('|---|---|---|---|---|')
     guess_cases = [('elastic_bar', 'cg', 10), ('plastic_bar', 'cg', 10), ('plastic_bar', 'gmres', 10)] + option_cases
     for problem, solver, mult in guess_cases:
-        model = os.path.join(OUT, problem + '.model')
-        newton, linear = TOL[problem]
-        initial = mult if problem == 'upsetting' else 1
-        cells = []
-        for guess in ('particles', 'previous'):
-            sets = ['solver.type=implicit', f'solver.implicit.formulation={"velocity" if solver == "cg" else "momentum"}',
-                    f'solver.implicit.newton_tolerance={newton}', f'solver.implicit.linear_tolerance={linear}',
-                    f'solver.implicit.dt_initial_multiple={initial}', f'solver.implicit.dt_target_multiple={mult}',
-                    f'solver.implicit.initial_guess={guess}']
-            r = tools.simulate(model, f'guess_{problem}_{solver}_{mult}_{guess}', sets,
-                               repeat=3 if problem != 'upsetting' or mult >= 1000 else 1)
-            cells.append(f'{int(r["evals"])}, {fmt(r["wall"], 3)}' if r['status'] == 0 else 'failed')
-            results['options'].append({'problem': problem, 'solver': solver, 'multiple': mult, 'initial_guess': guess,
-                                       'evals': r.get('evals'), 'wall': r.get('wall')})
+        cells = [option_run(problem, solver, mult, {'initial_guess': guess}) for guess in ('particles', 'previous')]
         md.append(f'| {problem} | {solver} | {mult} | ' + ' | '.join(cells) + ' |')
     md.append('')
 
