@@ -174,29 +174,15 @@ TEST(RegressionImplicit, PlasticBarStickingEndsV7) {
 // tolerance (stress agreement 1e-5 relative asserted; measured 6e-8) for fewer residual
 // evaluations (measured 2597 -> 1220: at least 30% fewer asserted; deterministic counts).
 TEST(RegressionImplicit, PreviousStepGuessSavesNewtonWork) {
-  const fs::path dir = temp_dir("implicit_v7_guess");
-  const fs::path scene = fs::path(MPM_EXAMPLES) / "implicit/plastic_bar.toml";
   std::map<std::string, std::pair<double, double>> got;  // guess -> (evaluations, sigma_xx)
   for (const std::string guess : {"particles", "previous"}) {
-    const fs::path stream = dir / (guess + ".mpm");
-    const Result r = run(prep + " " + scene.string() + " | " + runner +
-                             " --threads 1 --progress none --set output.frames=1"
-                             " --set solver.type=implicit --set solver.implicit.formulation=velocity"
-                             " --set solver.implicit.dt_target_multiple=10"
-                             " --set solver.implicit.newton_tolerance=1e-6"
-                             " --set solver.implicit.linear_tolerance=1e-4"
-                             " --set solver.implicit.initial_guess=" + guess + " -o " + stream.string(),
-                         dir);
-    ASSERT_EQ(r.status, 0) << r.err;
-    const Result h = run(post + " history " + stream.string() + " --columns residual_evals_total", dir);
+    const Case c = run_case("guess_" + guess);
+    const Result h = run(post + " history " + c.stream.string() + " --columns residual_evals_total", c.dir);
     ASSERT_EQ(h.status, 0) << h.err;
-    const Result q = run(post + " particles " + stream.string() + " --columns sigma,material", dir);
-    ASSERT_EQ(q.status, 0) << q.err;
     double sum = 0;
-    int n = 0;
-    for (auto& p : csv(q.out))
-      if (p["material"] != 255) sum += p["sigma_0"], ++n;
-    got[guess] = {csv(h.out).back().at("residual_evals_total"), sum / n};
+    const auto rows = material(c, "sigma,material");
+    for (const auto& p : rows) sum += p.at("sigma_0");
+    got[guess] = {csv(h.out).back().at("residual_evals_total"), sum / rows.size()};
   }
   const auto& [e_part, s_part] = got["particles"];
   const auto& [e_prev, s_prev] = got["previous"];

@@ -4,18 +4,25 @@
 
 #include <array>
 #include <cmath>
+#include <string>
 
 #include "mpm/materials/material.hpp"
 
 namespace mpm {
 namespace {
 
-MaterialSpec copper() {
+/// An elastic solid; the tests add strength, EOS and failure.
+MaterialSpec solid(const std::string& name, double density, double E, double nu) {
   MaterialSpec m;
-  m.name = "copper";
-  m.density = 8930;
-  m.youngs_modulus = 117e9;
-  m.poisson_ratio = 0.35;
+  m.name = name;
+  m.density = density;
+  m.youngs_modulus = E;
+  m.poisson_ratio = nu;
+  return m;
+}
+
+MaterialSpec copper() {
+  MaterialSpec m = solid("copper", 8930, 117e9, 0.35);
   m.strength.model = StrengthModel::J2;
   m.strength.A = 157e6;
   m.strength.B = 425e6;
@@ -394,11 +401,7 @@ TEST(Materials, PlaneStressJ2UniaxialStressCurve) {
 // rho_H = rho0 U_s / (U_s - u_p) exactly (V4: u_p = 3.29 km/s, 21 802 kg/m^3; a weak shock).
 // The signal speed behind it is above the unshocked one and grows with u_p.
 TEST(Materials, HugoniotStateOfTheShockEstimate) {
-  MaterialSpec lead;
-  lead.name = "lead";
-  lead.density = 11350;
-  lead.youngs_modulus = 22.4e9;
-  lead.poisson_ratio = 0.42;
+  MaterialSpec lead = solid("lead", 11350, 22.4e9, 0.42);
   lead.eos.model = EosModel::MieGruneisen;
   lead.eos.c0 = 2092;
   lead.eos.s = 1.45;
