@@ -35,7 +35,7 @@ TaylorResult TaylorMeter::measure(const Frame& frame) const {
   TaylorResult r;
   r.time = frame.time;
   const BodySpec& spec = scene_.bodies[body_];
-  r.spacing = scene_.grid.cell_size / spec.particles_per_cell;
+  r.spacing = spec.spacing(scene_.grid.cell_size);
   r.measure = opt_.surface ? "surface" : "centres";
 
   // Bounding box and mass centre of the body's particles.
@@ -256,7 +256,7 @@ DebrisMeter::DebrisMeter(const Scene& scene, const Frame& first, const DebrisOpt
   }
   if (np == 0 || far < -1e299) throw InputError("debris", "the first frame lacks the projectile or the target");
   point_ /= double(np);
-  const double spacing = scene.grid.cell_size / scene.bodies[target].particles_per_cell;
+  const double spacing = scene.bodies[target].spacing(scene.grid.cell_size);
   plane_ = opt_.plane ? *opt_.plane : direction_ * (far + 0.5 * spacing);
   link_ = opt_.link > 0 ? opt_.link : scene.grid.cell_size;
   if (opt_.min_fragment < 1) throw InputError("--min-fragment", "expected at least 1 particle");

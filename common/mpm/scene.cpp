@@ -10,6 +10,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cctype>
 #include <charconv>
 #include <climits>
@@ -586,7 +587,7 @@ bool valid_name(std::string_view s) {
 
 const std::vector<std::string_view> kBodyKeys = {
     "name", "material", "shape",  "size",      "radius",   "length",
-    "file", "scale",    "rotate", "translate", "velocity", "particles_per_cell", "rigid",
+    "file", "scale",    "rotate", "translate", "velocity", "particles_per_cell", "particle_spacing", "rigid",
     "slip"};
 
 BodySpec read_body(Reader& r, const Scene& scene) {
@@ -687,6 +688,14 @@ BodySpec read_body(Reader& r, const Scene& scene) {
   if (auto v = r.vector("translate", dim::length, n)) b.translate = *v;
   if (auto v = r.vector("velocity", dim::velocity, n)) b.velocity = *v;
   b.particles_per_cell = static_cast<int>(r.integer("particles_per_cell", 1, 8).value_or(2));
+  if (auto sp = r.quantity("particle_spacing", dim::length, Bound::Positive)) {
+    // One or the other (a --set of one removes the other: apply_override).
+    if (r.has("particles_per_cell"))
+      r.fail("particle_spacing",
+             "give either particles_per_cell (the spacing is the cell size over it) or "
+             "particle_spacing, not both");
+    b.particle_spacing = *sp;
+  }
   if (auto slip = r.string("slip")) {
     // The axes along which a rigid body's contact is frictionless: "y", "x z", "xz"; "none":
     // no-slip (the default, for --set).
@@ -911,6 +920,26 @@ void read_grid(Reader& r, Scene& s) {
   }
   g.sparse = r.boolean("sparse").value_or(false);
   read_levels(r, s);
+  for (const BodySpec& b : s.bodies) {
+    if (b.particle_spacing <= 0) continue;
+    const std::string key = "bodies." + b.name + ".particle_spacing";
+    const auto mm = [](double v) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.6g mm", v * 1e3);
+      return std::string(buf);
+    };
+    if (!g.levels.empty())
+      throw InputError(where(b.loc.file, b.loc.line, key),
+                       "a graded grid ([[grid.levels]]) sets each level's spacing from its cells: "
+                       "use particles_per_cell");
+    // At least a particle per cell along each axis, and at most 16 (the voxeliser's limit).
+    if (b.particle_spacing > g.cell_size * (1 + 1e-9) || b.particle_spacing < g.cell_size / 16)
+      throw InputError(where(b.loc.file, b.loc.line, key),
+                       "expected a spacing from grid.cell_size / 16 to grid.cell_size (" +
+                           mm(g.cell_size / 16) + " to " + mm(g.cell_size) +
+                           "): coarser particles leave cells inside the body empty (got " +
+                           mm(b.particle_spacing) + ")");
+  }
   if (g.sparse && !g.levels.empty())
     r.fail("sparse", "a graded grid ([[grid.levels]]) keeps its own node list; use one or the other");
   r.finish();
@@ -1261,6 +1290,13 @@ void apply_override(toml::table& root, const std::string& arg, Doc& doc) {
   auto [it, inserted] =
       v ? t->insert_or_assign(parts.back(), *v) : t->insert_or_assign(parts.back(), value);
   doc.record(it->second, key);
+  // A body's particles are set by particles_per_cell or by particle_spacing: setting one
+  // replaces the other, so a script can switch a scene's body between them (and the document,
+  // which the model carries, stays one a parser accepts).
+  if (parts[0] == "bodies" && parts.size() == 3) {
+    if (parts[2] == "particle_spacing") t->erase("particles_per_cell");
+    if (parts[2] == "particles_per_cell") t->erase("particle_spacing");
+  }
 }
 
 /// True when every float in the document is exact with 6 significant digits; then the

@@ -90,6 +90,11 @@ struct BodySpec {
   Vec3 translate = Vec3::Zero(); ///< applied last, m
   Vec3 velocity = Vec3::Zero();  ///< initial velocity, m/s (rigid bodies: kept for ever)
   int particles_per_cell = 2;    ///< per axis: n x n x n particles in each cell
+  /// Particle spacing, m, when given (particle_spacing): a lattice of its own, centred on the
+  /// body, independent of the cells; 0: cell_size / particles_per_cell.
+  double particle_spacing = 0;
+  /// The body's particle spacing on cells of size h.
+  double spacing(double h) const { return particle_spacing > 0 ? particle_spacing : h / particles_per_cell; }
   bool rigid = false;            ///< moves at `velocity` whatever happens
   /// Rigid bodies: bit a set = the contact is frictionless along axis a (the nodes the body
   /// touches keep the material's velocity in that component); 0 = no-slip (all components).

@@ -294,14 +294,18 @@ namespace {
 /// z = c0[2] + r / ny); row r owns `words` 64-bit words of `bits`, one bit per candidate in
 /// output order (cell x, then the points of the cell, pz slowest, then py, px).
 struct BodyPlan {
-  int n = 0, ppc = 0;              // points per cell per axis, per cell
   std::array<long long, 3> c0{}, c1{};  // cell range [c0, c1) per axis
   long long ny = 0, rows = 0, words = 0;
-  std::vector<double> xs, ys, zs;  // candidate coordinates per axis, m
+  // Candidate points per axis, in increasing order: the coordinates (m) and, for each cell
+  // c0 + c of the range, the first of its points (first[c] .. first[c + 1]). With
+  // particles_per_cell = n every cell holds n; with particle_spacing the count varies.
+  std::array<std::vector<double>, 3> at;
+  std::array<std::vector<long long>, 3> first;
   std::vector<std::uint64_t> bits;
   std::vector<std::uint64_t> row_start;  // prefix sums of kept points per row (rows + 1)
   std::size_t kept = 0, skipped = 0;
-  double particle_volume = 0, mass = 0;
+  double spacing = 0, particle_volume = 0, mass = 0;
+  long long count(int a, long long c) const { return first[a][c + 1] - first[a][c]; }
 };
 
 /// Density of a body's particles; rigid bodies carry a nominal 1 kg/m^3 (their mass is their
@@ -341,7 +345,7 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
       throw InputError(where(scene.source, scene.materials[body.material].loc.line,
                              "materials." + scene.materials[body.material].name + ".density"),
                        "the density must be positive, in kg/m^3 (got " + num(rho) + ")");
-    if (body.particles_per_cell < 1 || body.particles_per_cell > 16)
+    if (body.particle_spacing <= 0 && (body.particles_per_cell < 1 || body.particles_per_cell > 16))
       throw InputError(body_where(scene, body, "particles_per_cell"),
                        "particles per cell (per axis) must be 1 to 16 (got " +
                            std::to_string(body.particles_per_cell) + ")");
@@ -360,10 +364,11 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
     const Region& region = *regions[b];
     const MeshRegion* mesh = dynamic_cast<const MeshRegion*>(&region);
     BodyPlan& P = plans[b];
+    // Spacing: particle_spacing, else h / particles_per_cell.
+    const bool by_spacing = body.particle_spacing > 0;
     const int n = body.particles_per_cell;
-    const double s = h / n;
-    P.n = n;
-    P.ppc = dim == 3 ? n * n * n : n * n;
+    const double s = by_spacing ? body.particle_spacing : h / n;
+    P.spacing = s;
     P.particle_volume = dim == 3 ? s * s * s : s * s * 1.0;  // 2D: 1 m thick (or per radian, times r)
     P.mass = density_of(scene, body) * P.particle_volume;
 
@@ -390,36 +395,68 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
       return InputError(body_where(scene, body, ""),
                         "body '" + body.name +
                             "' has no particles: it lies outside the domain or is thinner than "
-                            "a particle spacing (h/n = " +
+                            "a particle spacing (" +
                             num(s) + " m)");
     };
     if (empty && cells.allow_empty) continue;  // nothing of this body in these cells
+
+    // Candidate points per axis, tabulated once so both passes use bit-identical values.
+    // particles_per_cell: cell corner + (i + 1/2) h / n, n in every cell. particle_spacing: a
+    // lattice centred on the body's bounding box, round(L / s) points along an extent L (at
+    // least one), so a box whose edges are multiples of s is tiled exactly and a sphere's
+    // lattice is symmetric about its centre; each point belongs to the cell it lies in.
+    std::array<long long, 3> most{1, 1, 1};  // most points of one cell along each axis
+    for (int a = 0; a < 3 && !empty; ++a) {
+      const long long m = a < dim ? P.c1[a] - P.c0[a] : 1;
+      auto& at = P.at[a];
+      auto& first = P.first[a];
+      at.clear();
+      first.assign(std::size_t(m) + 1, 0);
+      if (a >= dim) {
+        at.push_back(0.0);
+        first[1] = 1;
+        continue;
+      }
+      if (!by_spacing) {
+        for (long long c = 0; c < m; ++c) {
+          for (int i = 0; i < n; ++i) at.push_back(lat.origin[a] + h * double(P.c0[a] + c) + (i + 0.5) * s);
+          first[std::size_t(c) + 1] = (c + 1) * n;
+        }
+        most[a] = n;
+        continue;
+      }
+      const double extent = bhi[b][a] - blo[b][a];
+      const double centre = 0.5 * (blo[b][a] + bhi[b][a]);
+      const long long points = std::max(1LL, std::llround(extent / s));
+      const double x0 = centre - 0.5 * double(points - 1) * s;
+      for (long long i = 0; i < points; ++i) {
+        const double x = x0 + double(i) * s;
+        const double c = std::floor((x - lat.origin[a]) / h) - double(P.c0[a]);
+        if (c < 0 || c >= double(m)) continue;  // outside the domain
+        at.push_back(x);
+        ++first[std::size_t(c) + 1];
+      }
+      for (long long c = 0; c < m; ++c) {
+        most[a] = std::max(most[a], first[std::size_t(c) + 1]);
+        first[std::size_t(c) + 1] += first[std::size_t(c)];
+      }
+      if (at.empty()) empty = true;
+    }
+    if (empty && cells.allow_empty) continue;
     if (empty) throw no_particles(0);
 
     const long long ncx = P.c1[0] - P.c0[0];
     P.ny = P.c1[1] - P.c0[1];
     P.rows = P.ny * (P.c1[2] - P.c0[2]);
-    const long long row_points = ncx * P.ppc;
+    // Row r's points in output order: cell x, then the points of the cell (z slowest, then y,
+    // x); the cell at ix starts at first_x[ix] * (points of the row's cell along y and z).
+    const long long row_points = static_cast<long long>(P.at[0].size()) * most[1] * most[2];
     P.words = (row_points + 63) / 64;
     const double candidates = double(P.rows) * double(P.words) * 64.0;
     if (candidates > std::ldexp(1.0, 38))
       throw InputError(body_where(scene, body, ""),
                        "body '" + body.name + "' spans " + count_str(candidates) +
                            " lattice points; a model holds at most 4294967295 particles");
-    // Candidate coordinates: cell corner + (i + 1/2) h/n, tabulated once so both passes use
-    // bit-identical values.
-    const auto table = [&](int a, std::vector<double>& out) {
-      const long long m = a < dim ? P.c1[a] - P.c0[a] : 1;
-      const int per = a < dim ? n : 1;
-      out.resize(std::size_t(m * per));
-      for (long long c = 0; c < m; ++c)
-        for (int i = 0; i < per; ++i)
-          out[std::size_t(c * per + i)] =
-              a < dim ? lat.origin[a] + h * double(P.c0[a] + c) + (i + 0.5) * s : 0.0;
-    };
-    table(0, P.xs);
-    table(1, P.ys);
-    table(2, P.zs);
     P.bits.assign(std::size_t(P.rows * P.words), 0);
 
     // Earlier bodies whose boxes meet this one's: a point inside one of them is skipped.
@@ -429,23 +466,25 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
         earlier.push_back(j);
 
     std::vector<std::uint64_t> row_kept(std::size_t(P.rows), 0), row_skipped(std::size_t(P.rows), 0);
-    const int nz = dim == 3 ? n : 1;
     const double z_step = dim == 3 ? h : 0.0;
 #pragma omp parallel for schedule(dynamic, 8)
     for (long long r = 0; r < P.rows; ++r) {
       const long long iy = r % P.ny, iz = r / P.ny;
+      const long long y0i = P.first[1][std::size_t(iy)], cy = P.count(1, iy);
+      const long long z0i = P.first[2][std::size_t(iz)], cz = P.count(2, iz);
       std::uint64_t* w = P.bits.data() + r * P.words;
       std::uint64_t kept = 0, skipped = 0;
       // known = 1: the cell is wholly inside the region (only earlier bodies are tested).
       const auto test_cell = [&](long long ix, int known) {
         if (cells.keep && !cells.keep({P.c0[0] + ix, P.c0[1] + iy, P.c0[2] + iz})) return;
-        std::uint64_t idx = std::uint64_t(ix) * P.ppc;
-        for (int pz = 0; pz < nz; ++pz) {
-          const double z = P.zs[std::size_t(iz * nz + pz)];
-          for (int py = 0; py < n; ++py) {
-            const double y = P.ys[std::size_t(iy * n + py)];
-            for (int px = 0; px < n; ++px, ++idx) {
-              const Vec3 x(P.xs[std::size_t(ix * n + px)], y, z);
+        const long long x0i = P.first[0][std::size_t(ix)], cx = P.count(0, ix);
+        std::uint64_t idx = std::uint64_t(x0i * cy * cz);
+        for (long long pz = 0; pz < cz; ++pz) {
+          const double z = P.at[2][std::size_t(z0i + pz)];
+          for (long long py = 0; py < cy; ++py) {
+            const double y = P.at[1][std::size_t(y0i + py)];
+            for (long long px = 0; px < cx; ++px, ++idx) {
+              const Vec3 x(P.at[0][std::size_t(x0i + px)], y, z);
               if (known != 1 && !region.contains(x)) continue;
               bool taken = false;
               for (std::size_t j : earlier)
@@ -527,7 +566,6 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
   for (std::size_t b = 0; b < nb; ++b) {
     const BodySpec& body = scene.bodies[b];
     const BodyPlan& P = plans[b];
-    const int n = P.n, nz = dim == 3 ? n : 1;
     const double density = density_of(scene, body);
     const auto body_id = static_cast<std::uint8_t>(b);
     const auto mat_id = static_cast<std::uint8_t>(body.rigid ? kRigidMaterial : body.material);
@@ -535,24 +573,30 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
 #pragma omp parallel for schedule(dynamic, 8)
     for (long long r = 0; r < P.rows; ++r) {
       const long long iy = r % P.ny, iz = r / P.ny;
+      const long long y0i = P.first[1][std::size_t(iy)], cy = P.count(1, iy);
+      const long long z0i = P.first[2][std::size_t(iz)], cz = P.count(2, iz);
+      const std::uint64_t per_x = std::uint64_t(cy * cz);  // points per x point of this row
       std::size_t k = base + P.row_start[std::size_t(r)];
       const std::uint64_t* w = P.bits.data() + r * P.words;
+      const auto& first_x = P.first[0];
+      std::size_t ix = 0;  // the cell of the current point: the bits come in increasing order
       for (long long wi = 0; wi < P.words; ++wi) {
         std::uint64_t word = w[wi];
         while (word) {
           const std::uint64_t idx = std::uint64_t(wi) * 64 + std::uint64_t(std::countr_zero(word));
           word &= word - 1;
-          const long long ix = static_cast<long long>(idx / P.ppc);
-          const int p = static_cast<int>(idx % P.ppc);
-          const int px = p % n, py = (p / n) % n, pz = p / (n * n);
+          while (std::uint64_t(first_x[ix + 1]) * per_x <= idx) ++ix;
+          const long long cx = first_x[ix + 1] - first_x[ix];
+          const long long p = static_cast<long long>(idx - std::uint64_t(first_x[ix]) * per_x);
+          const long long px = p % cx, py = (p / cx) % cy, pz = p / (cx * cy);
           double* x = xcol + k * dim;
           double* v = vcol + k * dim;
-          x[0] = P.xs[std::size_t(ix * n + px)];
-          x[1] = P.ys[std::size_t(iy * n + py)];
+          x[0] = P.at[0][std::size_t(first_x[ix] + px)];
+          x[1] = P.at[1][std::size_t(y0i + py)];
           v[0] = body.velocity.x();
           v[1] = body.velocity.y();
           if (dim == 3) {
-            x[2] = P.zs[std::size_t(iz * nz + pz)];
+            x[2] = P.at[2][std::size_t(z0i + pz)];
             v[2] = body.velocity.z();
           }
           id[k] = static_cast<std::uint32_t>(k);
@@ -579,7 +623,7 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
       regions[b]->bounds(lo, hi);
       rep.exact_mass *= 0.5 * (lo.x() + hi.x());
     }
-    rep.spacing = h / n;
+    rep.spacing = P.spacing;
     rep.skipped_overlap = P.skipped;
     report.push_back(rep);
   }

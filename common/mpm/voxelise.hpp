@@ -1,6 +1,8 @@
 #pragma once
 /// Bodies to particles (mpm-prep). Each body becomes n x n x n particles per cell (n x n in 2D)
-/// at cell-aligned positions (cell corner + (i + 1/2) h / n) that lie inside the body.
+/// at cell-aligned positions (cell corner + (i + 1/2) h / n) that lie inside the body, or, with
+/// particle_spacing s, the points inside it of a lattice of spacing s centred on its bounding
+/// box (round(L / s) points along each extent L), whatever the cells.
 /// Primitives use exact inside tests; meshes (STL, OFF, OBJ) use CGAL's Side_of_triangle_mesh
 /// on an AABB tree and must be closed.
 #include <array>
@@ -39,7 +41,7 @@ struct BodyReport {
   std::size_t particles = 0;
   double mass = 0;          ///< sum of particle masses, kg (per metre of thickness in 2D)
   double exact_mass = 0;    ///< density x exact volume, kg
-  double spacing = 0;       ///< particle spacing h / n, m
+  double spacing = 0;       ///< particle spacing (h / n, or particle_spacing), m
   std::size_t skipped_overlap = 0;  ///< points inside an earlier body, not created again
 };
 

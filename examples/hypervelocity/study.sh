@@ -24,9 +24,11 @@ for variant in "$@"; do
             --set "bodies.sphere.particles_per_cell=$n" --set 'bodies.plate.size=6.36 140 140 mm') ;;
     large)
       frames=2
-      sets=(--set 'grid.cell_size=1.05 mm' --set bodies.plate.particles_per_cell=5
-            --set bodies.sphere.particles_per_cell=5 --set 'bodies.plate.size=6.36 140 140 mm'
-            --set 'grid.domain={ min = "-50.4 -82.95 -82.95 mm", max = "248.85 82.95 82.95 mm" }'
+      # The seed's large model: 0.21 mm spacing in 1 mm cells (4.76 particles per cell along
+      # each axis, so the spacing is the bodies' own, not cell_size / particles_per_cell).
+      sets=(--set 'grid.cell_size=1 mm' --set 'bodies.plate.particle_spacing=0.21 mm'
+            --set 'bodies.sphere.particle_spacing=0.21 mm' --set 'bodies.plate.size=6.36 140 140 mm'
+            --set 'grid.domain={ min = "-51 -83 -83 mm", max = "249 83 83 mm" }'
             --set output.precision=float32) ;;
     *) echo "unknown variant $variant" >&2; exit 2 ;;
   esac

@@ -469,6 +469,17 @@ TEST(SceneErrors, InlineCases) {
        "bodies.bar.particles_per_cell: expected an integer, got 2.5 (a floating-point number)"},
       {"particles per cell range", body_end, body_end + "\nparticles_per_cell = 9", "particles_per",
        "bodies.bar.particles_per_cell: must be between 1 and 8, got 9"},
+      {"particle spacing and particles per cell", body_end,
+       body_end + "\nparticles_per_cell = 3\nparticle_spacing = \"0.2 mm\"", "particle_spacing",
+       "bodies.bar.particle_spacing: give either particles_per_cell (the spacing is the cell size "
+       "over it) or particle_spacing, not both"},
+      {"particle spacing above the cell", body_end, body_end + "\nparticle_spacing = \"1 mm\"",
+       "[[bodies]]",
+       "bodies.bar.particle_spacing: expected a spacing from grid.cell_size / 16 to "
+       "grid.cell_size (0.0475 mm to 0.76 mm): coarser particles leave cells inside the body "
+       "empty (got 1 mm)"},
+      {"particle spacing not a length", body_end, body_end + "\nparticle_spacing = \"0.2 kg\"",
+       "particle_spacing", "bodies.bar.particle_spacing: expected a length"},
       {"scale zero", body_end, body_end + "\nscale = \"1 0 1\"", "scale",
        "bodies.bar.scale: every component must be > 0, got '1 0 1'"},
       {"vector with wrong unit", body_end, "velocity = \"0 0 -190 m\"", "velocity",
@@ -667,6 +678,31 @@ TEST(SceneOverrides, ApplyByBodyNameAndIndex) {
   // Later overrides win.
   s = parse(kBase, {"solver.cfl=0.3", "solver.cfl=0.2"});
   EXPECT_EQ(s.solver.cfl, 0.2);
+}
+
+TEST(SceneOverrides, SettingSpacingOrParticlesPerCellReplacesTheOther) {
+  const std::string body_end = "velocity = \"0 0 -190 m/s\"";
+  // The file gives particles_per_cell; --set particle_spacing switches this run to a spacing.
+  const std::string n3 = with(kBase, body_end, body_end + "\nparticles_per_cell = 3");
+  Scene s = parse(n3, {"bodies.bar.particle_spacing=0.2 mm"});
+  expect_si(s.bodies[0].particle_spacing, 0.2e-3);
+  EXPECT_DOUBLE_EQ(s.bodies[0].spacing(s.grid.cell_size), 0.2e-3);
+  // The file gives particle_spacing; --set particles_per_cell switches back.
+  const std::string sp = with(kBase, body_end, body_end + "\nparticle_spacing = \"0.2 mm\"");
+  s = parse(sp);
+  expect_si(s.bodies[0].spacing(s.grid.cell_size), 0.2e-3);
+  s = parse(sp, {"bodies.bar.particles_per_cell=4"});
+  EXPECT_EQ(s.bodies[0].particle_spacing, 0.0);
+  EXPECT_DOUBLE_EQ(s.bodies[0].spacing(s.grid.cell_size), 0.76e-3 / 4);
+  // Both from --set: the later wins, as for any key.
+  s = parse(kBase, {"bodies.bar.particles_per_cell=4", "bodies.bar.particle_spacing=0.2 mm"});
+  expect_si(s.bodies[0].particle_spacing, 0.2e-3);
+  // The document a model carries (the scene with its overrides) parses to the same body.
+  const Scene again = parse_scene(s.toml, "model", "/scenes", {});
+  EXPECT_EQ(again.bodies[0].particle_spacing, s.bodies[0].particle_spacing);
+  const Scene back = parse_scene(parse(sp, {"bodies.bar.particles_per_cell=4"}).toml, "model", "/scenes", {});
+  EXPECT_EQ(back.bodies[0].particle_spacing, 0.0);
+  EXPECT_EQ(back.bodies[0].particles_per_cell, 4);
 }
 
 TEST(SceneOverrides, ValuesAreTomlOrStrings) {
