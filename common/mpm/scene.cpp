@@ -10,11 +10,11 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <cctype>
 #include <charconv>
 #include <climits>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -933,12 +933,16 @@ void read_grid(Reader& r, Scene& s) {
                        "a graded grid ([[grid.levels]]) sets each level's spacing from its cells: "
                        "use particles_per_cell");
     // At least a particle per cell along each axis, and at most 16 (the voxeliser's limit).
-    if (b.particle_spacing > g.cell_size * (1 + 1e-9) || b.particle_spacing < g.cell_size / 16)
+    const std::string range = "expected a spacing from grid.cell_size / 16 to grid.cell_size (" +
+                              mm(g.cell_size / 16) + " to " + mm(g.cell_size) + ")";
+    if (b.particle_spacing > g.cell_size * (1 + 1e-9))
       throw InputError(where(b.loc.file, b.loc.line, key),
-                       "expected a spacing from grid.cell_size / 16 to grid.cell_size (" +
-                           mm(g.cell_size / 16) + " to " + mm(g.cell_size) +
-                           "): coarser particles leave cells inside the body empty (got " +
+                       range + ": coarser particles leave cells inside the body empty (got " +
                            mm(b.particle_spacing) + ")");
+    if (b.particle_spacing < g.cell_size / 16 * (1 - 1e-9))
+      throw InputError(where(b.loc.file, b.loc.line, key),
+                       range + ": finer particles than 16 per cell along an axis (got " +
+                           mm(b.particle_spacing) + "; refine the cells instead)");
   }
   if (g.sparse && !g.levels.empty())
     r.fail("sparse", "a graded grid ([[grid.levels]]) keeps its own node list; use one or the other");
@@ -1294,8 +1298,12 @@ void apply_override(toml::table& root, const std::string& arg, Doc& doc) {
   // replaces the other, so a script can switch a scene's body between them (and the document,
   // which the model carries, stays one a parser accepts).
   if (parts[0] == "bodies" && parts.size() == 3) {
-    if (parts[2] == "particle_spacing") t->erase("particles_per_cell");
-    if (parts[2] == "particles_per_cell") t->erase("particle_spacing");
+    const auto drop = [&](const char* other) {
+      if (const toml::node* n = t->get(other)) doc.set_by.erase(n);
+      t->erase(other);
+    };
+    if (parts[2] == "particle_spacing") drop("particles_per_cell");
+    if (parts[2] == "particles_per_cell") drop("particle_spacing");
   }
 }
 

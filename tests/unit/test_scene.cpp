@@ -478,6 +478,11 @@ TEST(SceneErrors, InlineCases) {
        "bodies.bar.particle_spacing: expected a spacing from grid.cell_size / 16 to "
        "grid.cell_size (0.0475 mm to 0.76 mm): coarser particles leave cells inside the body "
        "empty (got 1 mm)"},
+      {"particle spacing below a sixteenth of the cell", body_end,
+       body_end + "\nparticle_spacing = \"0.04 mm\"", "[[bodies]]",
+       "bodies.bar.particle_spacing: expected a spacing from grid.cell_size / 16 to "
+       "grid.cell_size (0.0475 mm to 0.76 mm): finer particles than 16 per cell along an axis "
+       "(got 0.04 mm; refine the cells instead)"},
       {"particle spacing not a length", body_end, body_end + "\nparticle_spacing = \"0.2 kg\"",
        "particle_spacing", "bodies.bar.particle_spacing: expected a length"},
       {"scale zero", body_end, body_end + "\nscale = \"1 0 1\"", "scale",
