@@ -200,6 +200,16 @@ class Reader {
     return {doc_->file, origin_.line, path_};
   }
 
+  /// Where a key's value is (its line, or the --set that gave it), as a SourceLoc for the
+  /// structs; mpm::where(loc.file, loc.line, loc.key) names it as Doc::where does.
+  SourceLoc loc_of(std::string_view key) const {
+    const toml::node* n = table_->get(key);
+    const Origin o = n ? origin_of(*n) : origin_;
+    const std::string path = key_path(key);
+    if (!o.set.empty()) return {"--set " + o.set, 0, o.set == path ? "" : path};
+    return {doc_->file, o.line, path};
+  }
+
   /// The key's value, or nullptr. Marks the key as read.
   const toml::node* get(std::string_view key) {
     if (std::find(keys_.begin(), keys_.end(), key) == keys_.end()) {
@@ -695,6 +705,7 @@ BodySpec read_body(Reader& r, const Scene& scene) {
              "give either particles_per_cell (the spacing is the cell size over it) or "
              "particle_spacing, not both");
     b.particle_spacing = *sp;
+    b.spacing_loc = r.loc_of("particle_spacing");
   }
   if (auto slip = r.string("slip")) {
     // The axes along which a rigid body's contact is frictionless: "y", "x z", "xz"; "none":
@@ -922,25 +933,25 @@ void read_grid(Reader& r, Scene& s) {
   read_levels(r, s);
   for (const BodySpec& b : s.bodies) {
     if (b.particle_spacing <= 0) continue;
-    const std::string key = "bodies." + b.name + ".particle_spacing";
+    const std::string at = where(b.spacing_loc.file, b.spacing_loc.line, b.spacing_loc.key);
     const auto mm = [](double v) {
       char buf[32];
       std::snprintf(buf, sizeof buf, "%.6g mm", v * 1e3);
       return std::string(buf);
     };
     if (!g.levels.empty())
-      throw InputError(where(b.loc.file, b.loc.line, key),
+      throw InputError(at,
                        "a graded grid ([[grid.levels]]) sets each level's spacing from its cells: "
                        "use particles_per_cell");
     // At least a particle per cell along each axis, and at most 16 (the voxeliser's limit).
     const std::string range = "expected a spacing from grid.cell_size / 16 to grid.cell_size (" +
                               mm(g.cell_size / 16) + " to " + mm(g.cell_size) + ")";
     if (b.particle_spacing > g.cell_size * (1 + 1e-9))
-      throw InputError(where(b.loc.file, b.loc.line, key),
+      throw InputError(at,
                        range + ": coarser particles leave cells inside the body empty (got " +
                            mm(b.particle_spacing) + ")");
     if (b.particle_spacing < g.cell_size / 16 * (1 - 1e-9))
-      throw InputError(where(b.loc.file, b.loc.line, key),
+      throw InputError(at,
                        range + ": finer particles than 16 per cell along an axis (got " +
                            mm(b.particle_spacing) + "; refine the cells instead)");
   }

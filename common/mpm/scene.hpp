@@ -93,6 +93,7 @@ struct BodySpec {
   /// Particle spacing, m, when given (particle_spacing): a lattice of its own, centred on the
   /// body, independent of the cells; 0: cell_size / particles_per_cell.
   double particle_spacing = 0;
+  SourceLoc spacing_loc;         ///< where particle_spacing was given (file line or --set)
   /// The body's particle spacing on cells of size h.
   double spacing(double h) const { return particle_spacing > 0 ? particle_spacing : h / particles_per_cell; }
   bool rigid = false;            ///< moves at `velocity` whatever happens

@@ -358,7 +358,7 @@ follow = "b"
   // A body's own particle spacing does not follow the levels' cells.
   EXPECT_EQ(error("[[grid.levels]]\nlevel = 2\nmin = \"3 3 3 mm\"\nmax = \"7 7 7 mm\"\n",
                   {"bodies.b.particle_spacing=0.3 mm"}),
-            "s.toml:5: bodies.b.particle_spacing: a graded grid ([[grid.levels]]) sets each level's "
+            "--set bodies.b.particle_spacing: a graded grid ([[grid.levels]]) sets each level's "
             "spacing from its cells: use particles_per_cell");
   EXPECT_EQ(error("[[grid.levels]]\nlevel = 2\nmin = \"3.5 3 3 mm\"\nmax = \"7 7 7 mm\"\n"),
             "s.toml:18: grid.levels.0.min: a level-2 box must lie on the level-1 lattice: x = 3.5 "

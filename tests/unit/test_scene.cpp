@@ -474,12 +474,12 @@ TEST(SceneErrors, InlineCases) {
        "bodies.bar.particle_spacing: give either particles_per_cell (the spacing is the cell size "
        "over it) or particle_spacing, not both"},
       {"particle spacing above the cell", body_end, body_end + "\nparticle_spacing = \"1 mm\"",
-       "[[bodies]]",
+       "particle_spacing",
        "bodies.bar.particle_spacing: expected a spacing from grid.cell_size / 16 to "
        "grid.cell_size (0.0475 mm to 0.76 mm): coarser particles leave cells inside the body "
        "empty (got 1 mm)"},
       {"particle spacing below a sixteenth of the cell", body_end,
-       body_end + "\nparticle_spacing = \"0.04 mm\"", "[[bodies]]",
+       body_end + "\nparticle_spacing = \"0.04 mm\"", "particle_spacing",
        "bodies.bar.particle_spacing: expected a spacing from grid.cell_size / 16 to "
        "grid.cell_size (0.0475 mm to 0.76 mm): finer particles than 16 per cell along an axis "
        "(got 0.04 mm; refine the cells instead)"},
