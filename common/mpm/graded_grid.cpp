@@ -7,25 +7,19 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <map>
 #include <stdexcept>
 
 #include "mpm/error.hpp"
+#include "mpm/units.hpp"
 
 namespace mpm {
 
 namespace {
 
 const char* axis_name(int a) { return a == 0 ? "x" : a == 1 ? "y" : "z"; }
-
-std::string fmt_mm(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", x * 1e3);
-  return b;
-}
 
 }  // namespace
 
@@ -34,7 +28,7 @@ std::string GradedGrid<D>::mm(const Vec<D>& x) const {
   std::string s;
   for (int a = 0; a < D; ++a) {
     if (a) s += ' ';
-    s += fmt_mm(x[a]);
+    s += format_mm(x[a]);
   }
   return s + " mm";
 }
@@ -96,7 +90,7 @@ GradedGrid<D>::GradedGrid(const Lattice& lattice, const Scene& scene)
             near[c] = origin_[c] + hp * std::round(((e ? s.max : s.min)[c] - origin_[c]) / hp);
           fail(b, e ? "max" : "min",
                std::string("must lie on the level-") + std::to_string(s.level - 1) +
-                   " lattice (multiples of " + fmt_mm(hp) + " mm from grid.domain.min) but " +
+                   " lattice (multiples of " + format_mm(hp) + " mm from grid.domain.min) but " +
                    axis_name(a) + " is off it; nearest: " + mm(near));
         }
         idx[e] = int(n) * 2;
@@ -255,7 +249,7 @@ bool GradedGrid<D>::build(bool validate) {
     if (!balanced)
       fail(b, "", "the level-" + std::to_string(l) + " box [" + mm(b.xmin) + ", " + mm(b.xmax) +
                       "] comes closer than one level-" + std::to_string(l - 1) + " cell (" +
-                      fmt_mm(parent.h) + " mm) to the edge of the level-" +
+                      format_mm(parent.h) + " mm) to the edge of the level-" +
                       std::to_string(l - 1) +
                       " region; keep that margin (except at the domain's faces) so that "
                       "neighbouring cells differ by one level at most");

@@ -100,7 +100,7 @@ void ExplicitSolver<GridT>::split_particles() {
   for (Column& c : particles_.columns()) cols.push_back({c.data(), c.info().element_bytes()});
   std::vector<double> spacing(scene_.bodies.size());  // per body: h1 / particles per cell
   for (std::size_t b = 0; b < spacing.size(); ++b)
-    spacing[b] = grid_.level_h(1) / scene_.bodies[b].particles_per_cell;
+    spacing[b] = scene_.bodies[b].spacing(grid_.level_h(1));
   const Vec<D> lo = grid_.domain_min(), hi = grid_.domain_max();
   const double inset = 1e-9 * grid_.min_cell_size();
   const std::uint32_t id0 = next_id_;

@@ -14,7 +14,6 @@
 #include <charconv>
 #include <climits>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -897,6 +896,31 @@ void read_levels(Reader& grid, Scene& s) {
   }
 }
 
+/// A body's own particle spacing against the grid (bodies are read before [grid]).
+void check_particle_spacing(const Scene& s) {
+  const GridSpec& g = s.grid;
+  for (const BodySpec& b : s.bodies) {
+    if (b.particle_spacing <= 0) continue;
+    const std::string at = where(b.spacing_loc.file, b.spacing_loc.line, b.spacing_loc.key);
+    const auto mm = [](double v) { return format_mm(v) + " mm"; };
+    if (!g.levels.empty())
+      throw InputError(at,
+                       "a graded grid ([[grid.levels]]) sets each level's spacing from its cells: "
+                       "use particles_per_cell");
+    // At least a particle per cell along each axis, and at most 16 (the voxeliser's limit).
+    const std::string range = "expected a spacing from grid.cell_size / 16 to grid.cell_size (" +
+                              mm(g.cell_size / 16) + " to " + mm(g.cell_size) + ")";
+    if (b.particle_spacing > g.cell_size * (1 + 1e-9))
+      throw InputError(at,
+                       range + ": coarser particles leave cells inside the body empty (got " +
+                           mm(b.particle_spacing) + ")");
+    if (b.particle_spacing < g.cell_size / 16 * (1 - 1e-9))
+      throw InputError(at,
+                       range + ": finer particles than 16 per cell along an axis (got " +
+                           mm(b.particle_spacing) + "; refine the cells instead)");
+  }
+}
+
 void read_grid(Reader& r, Scene& s) {
   const int n = s.dimension;
   GridSpec& g = s.grid;
@@ -931,30 +955,6 @@ void read_grid(Reader& r, Scene& s) {
   }
   g.sparse = r.boolean("sparse").value_or(false);
   read_levels(r, s);
-  for (const BodySpec& b : s.bodies) {
-    if (b.particle_spacing <= 0) continue;
-    const std::string at = where(b.spacing_loc.file, b.spacing_loc.line, b.spacing_loc.key);
-    const auto mm = [](double v) {
-      char buf[32];
-      std::snprintf(buf, sizeof buf, "%.6g mm", v * 1e3);
-      return std::string(buf);
-    };
-    if (!g.levels.empty())
-      throw InputError(at,
-                       "a graded grid ([[grid.levels]]) sets each level's spacing from its cells: "
-                       "use particles_per_cell");
-    // At least a particle per cell along each axis, and at most 16 (the voxeliser's limit).
-    const std::string range = "expected a spacing from grid.cell_size / 16 to grid.cell_size (" +
-                              mm(g.cell_size / 16) + " to " + mm(g.cell_size) + ")";
-    if (b.particle_spacing > g.cell_size * (1 + 1e-9))
-      throw InputError(at,
-                       range + ": coarser particles leave cells inside the body empty (got " +
-                           mm(b.particle_spacing) + ")");
-    if (b.particle_spacing < g.cell_size / 16 * (1 - 1e-9))
-      throw InputError(at,
-                       range + ": finer particles than 16 per cell along an axis (got " +
-                           mm(b.particle_spacing) + "; refine the cells instead)");
-  }
   if (g.sparse && !g.levels.empty())
     r.fail("sparse", "a graded grid ([[grid.levels]]) keeps its own node list; use one or the other");
   r.finish();
@@ -1153,6 +1153,7 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
                            "cell_size is required");
     read_grid(g, s);
   }
+  check_particle_spacing(s);
   if (auto b =
           top.table("boundary", {"all", "x_min", "x_max", "y_min", "y_max", "z_min", "z_max"})) {
     read_boundary(*b, s);

@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -360,6 +361,12 @@ std::string describe(const Dimension& d) {
   term("s", d.T);
   term("K", d.K);
   return s;
+}
+
+std::string format_mm(double metres) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", metres * 1e3);
+  return b;
 }
 
 }  // namespace mpm

@@ -50,4 +50,7 @@ std::vector<Quantity> parse_vector(std::string_view text);
 /// Human name of a dimension with its SI unit, e.g. "a density (kg/m^3)".
 std::string describe(const Dimension& d);
 
+/// A length in metres as millimetres for messages, 6 significant digits, no unit: "0.0475".
+std::string format_mm(double metres);
+
 }  // namespace mpm

@@ -398,7 +398,6 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
                             "a particle spacing (" +
                             num(s) + " m)");
     };
-    if (empty && cells.allow_empty) continue;  // nothing of this body in these cells
 
     // Candidate points per axis, tabulated once so both passes use bit-identical values.
     // particles_per_cell: cell corner + (i + 1/2) h / n, n in every cell. particle_spacing: a
@@ -442,7 +441,7 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
       }
       if (at.empty()) empty = true;
     }
-    if (empty && cells.allow_empty) continue;
+    if (empty && cells.allow_empty) continue;  // nothing of this body in these cells
     if (empty) throw no_particles(0);
 
     const long long ncx = P.c1[0] - P.c0[0];
