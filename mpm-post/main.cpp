@@ -373,8 +373,9 @@ int cmd_debris(const std::string& path, const DebrisArgs& a) {
                 json_number(r.width_max).c_str(), json_number(r.width_p99).c_str(),
                 json_number(r.width_p995).c_str(), json_number(r.width_p999).c_str());
     std::printf(", \"link\": %s, \"min_fragment\": %zu, \"fragments\": %zu, \"single_particle_fragments\": %zu, "
-                "\"largest_fragment\": %zu, \"counted_particles\": %zu",
-                json_number(r.link).c_str(), r.min_fragment, r.fragments, r.singles, r.largest, r.counted);
+                "\"largest_fragment\": %zu, \"counted_particles\": %zu, \"percentiles_of\": \"%s\"",
+                json_number(r.link).c_str(), r.min_fragment, r.fragments, r.singles, r.largest, r.counted,
+                r.by_mass ? "mass" : "particles");
     if (ef) std::printf(", \"expected_front\": %s, \"error_front\": %s", json_number(*ef).c_str(), json_number(r.front / *ef - 1).c_str());
     if (ew) std::printf(", \"expected_width\": %s, \"error_width\": %s", json_number(*ew).c_str(), json_number(r.width / *ew - 1).c_str());
     std::printf("}\n");
@@ -396,7 +397,7 @@ int cmd_debris(const std::string& path, const DebrisArgs& a) {
     if (ef) std::printf(" (expected %.1f mm, %+.1f%%)", *ef * 1e3, 100 * (r.front / *ef - 1));
     std::printf(", width = %.1f mm", r.width * 1e3);
     if (ew) std::printf(" (expected %.1f mm, %+.1f%%)", *ew * 1e3, 100 * (r.width / *ew - 1));
-    std::printf("   [%g-th percentile of the cloud's particles]\n", r.percentile);
+    std::printf("   [%g-th percentile of the cloud's %s]\n", r.percentile, r.by_mass ? "mass" : "particles");
   }
   std::fflush(stdout);
   return conclude(path, s, frames);
@@ -753,8 +754,8 @@ int main(int argc, char** argv) {
   debris->add_option("--projectile", da.projectile, "projectile body (default: the fastest body)");
   debris->add_option("--percentile", da.percentile,
                      "which particles count: the front and width reported are this percentile of the "
-                     "cloud's distances (stray particles beyond it are ignored; max and 99/99.5/99.9 are "
-                     "always printed)")
+                     "cloud's distances, by mass (stray particles beyond it are ignored; max and 99/99.5/99.9 "
+                     "are always printed; axisymmetric: the axis is y, each ring weighs its mass)")
       ->check(CLI::Range(0.0, 100.0))->capture_default_str();
   debris->add_option("--min-fragment", da.min_fragment,
                      "which particles count: only those of fragments of at least this many particles "

@@ -135,6 +135,28 @@ double percentile(std::vector<double> v, double p) {
   return v[p <= 0 ? 0 : k];
 }
 
+/// p-th percentile (0..100) of values weighted by w (> 0): the smallest value whose cumulative
+/// weight, in ascending order of the values, reaches p / 100 of the total. With equal weights
+/// it is the nearest-rank percentile above, which is then used as is (sums of many equal
+/// weights round, and would move a rank that falls on a whole number).
+double percentile(const std::vector<double>& v, const std::vector<double>& w, double p) {
+  if (v.empty()) return 0;
+  if (std::all_of(w.begin(), w.end(), [&](double x) { return x == w[0]; })) return percentile(v, p);
+  std::vector<std::size_t> order(v.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return v[a] < v[b]; });
+  if (p <= 0) return v[order.front()];
+  long double total = 0;
+  for (const double x : w) total += x;
+  const long double target = (long double)(p / 100.0) * total * (1 - 1e-12L);
+  long double sum = 0;
+  for (const std::size_t i : order) {
+    sum += w[i];
+    if (sum >= target) return v[i];
+  }
+  return v[order.back()];
+}
+
 }  // namespace
 
 std::vector<std::size_t> fragment_sizes(const std::vector<Vec3>& points, double link) {
@@ -237,7 +259,11 @@ DebrisMeter::DebrisMeter(const Scene& scene, const Frame& first, const DebrisOpt
     if (target < 0) throw InputError("debris", "no body is at rest at t = 0: give --target");
   }
   const Vec3 vp = scene.bodies[proj].velocity;
+  axisymmetric_ = scene.axisymmetric;
   axis_ = opt_.axis;
+  if (axisymmetric_ && axis_ >= 0 && axis_ != 1)
+    throw InputError("--axis", "an axisymmetric scene's impact axis is its axis of revolution y (x is the radius)");
+  if (axisymmetric_) axis_ = 1;
   if (axis_ < 0) {
     axis_ = 0;
     for (int a = 1; a < dim_; ++a)
@@ -256,6 +282,7 @@ DebrisMeter::DebrisMeter(const Scene& scene, const Frame& first, const DebrisOpt
   }
   if (np == 0 || far < -1e299) throw InputError("debris", "the first frame lacks the projectile or the target");
   point_ /= double(np);
+  if (axisymmetric_) point_.x() = 0;  // the axis of revolution, whatever the projectile's rings
   const double spacing = scene.bodies[target].spacing(scene.grid.cell_size);
   plane_ = opt_.plane ? *opt_.plane : direction_ * (far + 0.5 * spacing);
   link_ = opt_.link > 0 ? opt_.link : scene.grid.cell_size;
@@ -276,11 +303,15 @@ DebrisResult DebrisMeter::measure(const Frame& frame) const {
   r.percentile = opt_.percentile;
   r.link = link_;
   r.min_fragment = opt_.min_fragment;
-  std::vector<double> front, width;
+  const Column* mc = frame.columns.find(col::m);
+  const double* m = mc ? reinterpret_cast<const double*>(mc->data()) : nullptr;
+  if (axisymmetric_ && !m) throw InputError("debris", "an axisymmetric frame needs the column 'm' (the rings' masses)");
+  std::vector<double> front, width, mass;
   std::vector<Vec3> cloud;
   for (std::size_t i = 0; i < n; ++i) {
     const double d = direction_ * (x[i * dim_ + axis_] - plane_);
     if (!(d > 0)) continue;
+    mass.push_back(m ? m[i] : 1.0);
     double r2 = 0;
     Vec3 p = Vec3::Zero();
     for (int a = 0; a < dim_; ++a) {
@@ -299,25 +330,27 @@ DebrisResult DebrisMeter::measure(const Frame& frame) const {
   for (std::size_t i = 0; i < size.size(); ++i) {
     r.largest = std::max(r.largest, size[i]);
     if (size[i] == 1) ++r.singles;
-    if (size[i] >= opt_.min_fragment) front[kept] = front[i], width[kept] = width[i], ++kept;
+    if (size[i] >= opt_.min_fragment) front[kept] = front[i], width[kept] = width[i], mass[kept] = mass[i], ++kept;
   }
   double fragments = 0;  // a fragment of k particles: k particles of 1 / k each
   for (const std::size_t k : size) fragments += 1.0 / double(k);
   r.fragments = std::size_t(std::llround(fragments));
   front.resize(kept);
   width.resize(kept);
+  mass.resize(kept);
   r.counted = kept;
   if (front.empty()) return r;
+  r.by_mass = !std::all_of(mass.begin(), mass.end(), [&](double w) { return w == mass[0]; });
   r.front_max = *std::max_element(front.begin(), front.end());
   r.width_max = *std::max_element(width.begin(), width.end());
-  r.front_p99 = percentile(front, 99);
-  r.front_p995 = percentile(front, 99.5);
-  r.front_p999 = percentile(front, 99.9);
-  r.width_p99 = percentile(width, 99);
-  r.width_p995 = percentile(width, 99.5);
-  r.width_p999 = percentile(width, 99.9);
-  r.front = percentile(front, opt_.percentile);
-  r.width = percentile(width, opt_.percentile);
+  r.front_p99 = percentile(front, mass, 99);
+  r.front_p995 = percentile(front, mass, 99.5);
+  r.front_p999 = percentile(front, mass, 99.9);
+  r.width_p99 = percentile(width, mass, 99);
+  r.width_p995 = percentile(width, mass, 99.5);
+  r.width_p999 = percentile(width, mass, 99.9);
+  r.front = percentile(front, mass, opt_.percentile);
+  r.width = percentile(width, mass, opt_.percentile);
   return r;
 }
 

@@ -81,6 +81,10 @@ struct DebrisResult {
   /// `min_fragment` particles, and the distances above are theirs.
   double link = 0;
   std::size_t min_fragment = 1, fragments = 0, singles = 0, largest = 0, counted = 0;
+  /// The percentiles are of the counted particles' mass (their masses differ: an axisymmetric
+  /// model, where a particle stands for a ring of mass proportional to its radius, or bodies of
+  /// different spacings), else of their number (equal masses, or frames without masses).
+  bool by_mass = false;
 };
 
 /// Fragments of a point set, friends of friends: points closer than `link` are in one
@@ -90,8 +94,10 @@ std::vector<std::size_t> fragment_sizes(const std::vector<Vec3>& points, double 
 /// Measures debris clouds: set up from the first frame (axis, plane), then measure any frame.
 /// The cloud is every particle downstream of the plane (the target's rear face, at the surface:
 /// its outermost particle centres plus half a spacing). Front: distance behind the plane along
-/// the impact direction; width: twice the distance from the impact axis. Particles count
-/// equally (they have equal masses in a model of one spacing). Throws InputError.
+/// the impact direction; width: twice the distance from the impact axis. Percentiles are of the
+/// cloud's mass (by number when all masses are equal: a model of one spacing). In an
+/// axisymmetric scene the impact axis is the axis of revolution y, the width twice the radius
+/// x, and a particle (a ring) weighs its mass per radian. Throws InputError.
 class DebrisMeter {
  public:
   DebrisMeter(const Scene& scene, const Frame& first, const DebrisOptions& options);
@@ -103,6 +109,7 @@ class DebrisMeter {
   double plane_ = 0;
   Vec3 point_ = Vec3::Zero();
   int dim_ = 3;
+  bool axisymmetric_ = false;
   double link_ = 0;
 };
 

@@ -17,6 +17,9 @@
 #include <filesystem>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "mpm/error.hpp"
 #include "mpm/mesh_region.hpp"
@@ -73,6 +76,7 @@ class PrimitiveRegion final : public Region {
       t_.z() = 0;
     }
     to_local_ = s.cwiseInverse().asDiagonal() * body_rotation(body).transpose();
+    A_ = A;
     const double ascale = std::abs(s.x() * s.y() * s.z());
     r2_ = body.radius * body.radius;
     half_ = 0.5 * body.size;
@@ -134,9 +138,47 @@ class PrimitiveRegion final : public Region {
     hi = hi_;
   }
 
+  double revolved_volume() const override {
+    if (dim_ != 2) return Region::revolved_volume();
+    const double detA = std::abs(A_(0, 0) * A_(1, 1) - A_(0, 1) * A_(1, 0));
+    if (kind_ == ShapeKind::Sphere) {
+      // The ellipse {A u + t : |u| <= R}: x = a.u + t_x with a the first row of A. With w the
+      // coordinate of u along a, the integral of x over x >= 0 is |det A| times the integral
+      // of (|a| w + t_x) 2 sqrt(R^2 - w^2) over w from max(-R, -t_x / |a|) to R.
+      const double R = std::sqrt(r2_), alpha = std::hypot(A_(0, 0), A_(0, 1));
+      const double w0 = std::clamp(-t_.x() / alpha, -R, R);
+      auto root = [&](double w) { return std::sqrt(std::max(0.0, (R - w) * (R + w))); };  // 0 at w = +-R
+      auto F = [&](double w) {  // of 2 sqrt(R^2 - w^2)
+        return w * root(w) + R * R * std::asin(std::clamp(w / R, -1.0, 1.0));
+      };
+      auto G = [&](double w) { return -2.0 / 3.0 * std::pow(root(w), 3); };  // of 2 w sqrt(R^2 - w^2)
+      return detA * (t_.x() * (F(R) - F(w0)) + alpha * (G(R) - G(w0)));
+    }
+    // The parallelogram of the box's corners, clipped to x >= 0 (one half-plane of
+    // Sutherland-Hodgman); its integral of x by the polygon formula
+    // (1/6) sum (x_i + x_j) (x_i y_j - x_j y_i), j = i + 1.
+    std::vector<Vec<2>> in, out;
+    for (const auto& [i, j] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}) {
+      const Vec3 c = A_ * Vec3(i * half_.x(), j * half_.y(), 0) + t_;
+      in.emplace_back(c.x(), c.y());
+    }
+    for (std::size_t k = 0; k < in.size(); ++k) {
+      const Vec<2> &p = in[k], &q = in[(k + 1) % in.size()];
+      if (p.x() >= 0) out.push_back(p);
+      if ((p.x() >= 0) != (q.x() >= 0)) out.emplace_back(0.0, p.y() + (q.y() - p.y()) * (0 - p.x()) / (q.x() - p.x()));
+    }
+    double moment = 0;
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      const Vec<2> &p = out[k], &q = out[(k + 1) % out.size()];
+      moment += (p.x() + q.x()) * (p.x() * q.y() - q.x() * p.y());
+    }
+    return std::abs(moment) / 6.0;
+  }
+
  private:
   ShapeKind kind_;
   int dim_;
+  Mat3 A_;
   Mat3 to_local_;
   Vec3 t_, half_, lo_, hi_;
   double r2_ = 0, length_ = 0, volume_ = 0;
@@ -614,19 +656,18 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
     rep.particles = P.kept;
     rep.mass = 0;
     for (std::size_t k = base - P.kept; k < base; ++k) rep.mass += mass[k];
-    rep.exact_mass = density * regions[b]->volume();  // 2D: area x 1 m
-    if (axi) {
-      // Per radian: area times the radius of its centroid (Pappus); the shapes allowed in 2D
-      // (boxes, disks) have their centroid at the centre of their bounding box.
-      Vec3 lo, hi;
-      regions[b]->bounds(lo, hi);
-      rep.exact_mass *= 0.5 * (lo.x() + hi.x());
-    }
+    // 2D: area x 1 m; axisymmetric: per radian, the part at r >= 0 (a body may cross the axis:
+    // a disk centred on it is a sphere).
+    rep.exact_mass = density * (axi ? regions[b]->revolved_volume() : regions[b]->volume());
     rep.spacing = P.spacing;
     rep.skipped_overlap = P.skipped;
     report.push_back(rep);
   }
   return store;
+}
+
+double Region::revolved_volume() const {
+  throw std::logic_error("revolved_volume: only the 2D primitives (boxes and disks) sweep a solid of revolution");
 }
 
 }  // namespace mpm

@@ -26,6 +26,10 @@ class Region {
   /// Exact volume (m^3; in 2D the area in m^2): analytic for primitives, the closed mesh's
   /// signed volume for meshes.
   virtual double volume() const = 0;
+  /// Axisymmetric 2D scenes: the volume per radian of the solid of revolution about the y
+  /// axis swept by the part of the region at x >= 0, the integral of x over that part (m^3).
+  /// Exact for the 2D primitives (rectangles, disks and their rotated, scaled images).
+  virtual double revolved_volume() const;
   /// World-space bounding box.
   virtual void bounds(Vec3& lo, Vec3& hi) const = 0;
 };

@@ -2,7 +2,8 @@
 # Runs V4 variants and appends a row per variant to out/table.md: particles, cells, steps,
 # wall time, throughput, peak memory, and the debris front and width at 30.6 us (99.5th
 # percentile, with the maxima) against the experiment (200 mm, 145 mm). Also a side-view PNG.
-# Usage: ./study.sh BUILD_DIR VARIANT...   (coarse, small-1.06, small-1.59, small-2.12, large)
+# Usage: ./study.sh BUILD_DIR VARIANT...   (coarse, small-1.06, small-1.59, small-2.12, large,
+#        axi-H: axisym.toml at H mm cells, 2 particles per cell, e.g. axi-0.265)
 set -euo pipefail
 cd "$(dirname "$0")"
 bin=$1; shift
@@ -15,6 +16,7 @@ table=out/table.md
 for variant in "$@"; do
   sets=()
   frames=6
+  scene=scene.toml
   case $variant in
     coarse) ;;
     small-*)
@@ -30,11 +32,14 @@ for variant in "$@"; do
             --set 'bodies.sphere.particle_spacing=0.21 mm' --set 'bodies.plate.size=6.36 140 140 mm'
             --set 'grid.domain={ min = "-51 -83 -83 mm", max = "249 83 83 mm" }'
             --set output.precision=float32) ;;
+    axi-*)
+      scene=axisym.toml
+      sets=(--set "grid.cell_size=${variant#axi-} mm") ;;
     *) echo "unknown variant $variant" >&2; exit 2 ;;
   esac
   out=out/$variant.mpm
   start=$(date +%s.%N)
-  "$bin/mpm-prep/mpm-prep" scene.toml "${sets[@]}" --set output.frames=$frames 2> out/prep_$variant.log |
+  "$bin/mpm-prep/mpm-prep" "$scene" "${sets[@]}" --set output.frames=$frames 2> out/prep_$variant.log |
     "$bin/mpm-run/mpm-run" --stats --progress lines -o "$out" 2> out/run_$variant.log
   end=$(date +%s.%N)
   "$bin/mpm-post/mpm-post" debris "$out" --time "30.6 us" --expect-front "200 mm" --expect-width "145 mm" | tee out/debris_$variant.txt

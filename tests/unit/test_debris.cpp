@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "mpm/error.hpp"
 #include "mpm/particles.hpp"
 #include "mpm/post.hpp"
 #include "mpm/scene.hpp"
@@ -29,19 +30,26 @@ Scene two_bodies() {
 }
 
 struct Cloud {
+  int dim = 3;
   std::vector<Vec3> x;
   std::vector<std::uint8_t> body;
+  std::vector<double> m;  ///< empty: frames without masses
   void add(const Vec3& p, int b) { x.push_back(p), body.push_back(std::uint8_t(b)); }
   Frame frame(double time) const {
     Frame f;
     f.time = time;
-    f.columns.add({col::x, ScalarType::F64, 3, "m"});
-    f.columns.add({col::v, ScalarType::F64, 3, "m/s"});
+    f.columns.add({col::x, ScalarType::F64, dim, "m"});
+    f.columns.add({col::v, ScalarType::F64, dim, "m/s"});
     f.columns.add({col::body, ScalarType::U8, 1, "-"});
+    if (!m.empty()) f.columns.add({col::m, ScalarType::F64, 1, "kg"});
     f.columns.resize(x.size());
-    auto* xs = f.columns.get<Vec3>(col::x);
+    auto* xs = reinterpret_cast<double*>(f.columns.at(col::x).data());
     auto* bs = f.columns.get<std::uint8_t>(col::body);
-    for (std::size_t i = 0; i < x.size(); ++i) xs[i] = x[i], bs[i] = body[i];
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      for (int a = 0; a < dim; ++a) xs[i * dim + a] = x[i][a];
+      bs[i] = body[i];
+    }
+    if (!m.empty()) std::copy(m.begin(), m.end(), f.columns.get<double>(col::m));
     return f;
   }
 };
@@ -84,6 +92,72 @@ TEST(Debris, PlaneAxisPercentilesAndMaximum) {
   const DebrisResult q = DebrisMeter(scene, start.frame(0), p90).measure(later.frame(30e-6));
   EXPECT_NEAR(q.front, 0.900, tol);
   EXPECT_NEAR(q.width, 0.900, tol);
+
+  // Equal masses: the percentiles are by number, to the bit.
+  later.m.assign(later.x.size(), 0.37);
+  const DebrisResult e = meter.measure(later.frame(30e-6));
+  EXPECT_FALSE(e.by_mass);
+  EXPECT_EQ(e.front_p995, r.front_p995);
+  EXPECT_EQ(e.width_p99, r.width_p99);
+  // Heavier particles weigh more: k <= 500 weigh 1, the farther ones 3 (total 2000). The 99.5th
+  // percentile is the smallest k whose cumulative mass 500 + 3 (k - 500) reaches 1990: k = 997
+  // (by number: 995).
+  for (int k = 1; k <= 1000; ++k) later.m[k - 1] = k <= 500 ? 1.0 : 3.0;
+  const DebrisResult w = meter.measure(later.frame(30e-6));
+  EXPECT_TRUE(w.by_mass);
+  EXPECT_NEAR(w.front_p995, 0.997, tol);
+  EXPECT_NEAR(w.front_max, 1.000, tol);
+}
+
+// An axisymmetric cloud (x the radius, y the axis): the axis is r = 0 whatever the projectile's
+// particles (rings at r > 0) average to, the width is twice the radius, and a ring weighs its
+// mass per radian, proportional to r. Rings k = 1..N at r_k = (k - 1/2) dr have cumulative
+// masses proportional to k^2 / 2: the p-th percentile is ring ceil(N sqrt(p)), where counting
+// particles would give ring ceil(N p).
+TEST(Debris, AxisymmetricCloudWeighsRingsByTheirMass) {
+  Scene scene = two_bodies();
+  scene.dimension = 2;
+  scene.axisymmetric = true;
+  scene.bodies[1].velocity = Vec3(0, 6580, 0);
+  Cloud start;
+  start.dim = 2;
+  for (int i = 0; i <= 5; ++i)
+    for (int j = 0; j < 20; ++j) start.add(Vec3((j + 0.5) * kS, i * kS, 0), 0);  // plate y 0..5 mm
+  for (int j = 0; j < 4; ++j) start.add(Vec3((j + 0.5) * kS, -2e-3, 0), 1);
+  start.m.assign(start.x.size(), 1.0);
+  const DebrisMeter meter(scene, start.frame(0), DebrisOptions{});
+
+  const int N = 1000;
+  const double dr = 0.1e-3;
+  Cloud later;
+  later.dim = 2;
+  for (int k = 1; k <= N; ++k) {  // ring k: k mm behind the rear face (y = 5.5 mm)
+    const double r = (k - 0.5) * dr;
+    later.add(Vec3(r, 5.5e-3 + k * 1e-3, 0), 1);
+    later.m.push_back(11350 * 1e-8 * r);  // rho A r
+  }
+  const DebrisResult a = meter.measure(later.frame(30e-6));
+  EXPECT_EQ(a.axis, 1);
+  EXPECT_NEAR(a.plane, 5.5e-3, 1e-15);
+  EXPECT_NEAR(a.axis_point.x(), 0.0, 0.0);
+  EXPECT_TRUE(a.by_mass);
+  const double tol = 1e-12;
+  auto ring = [&](double p) { return int(std::ceil(N * std::sqrt(p) - 1e-9)); };
+  EXPECT_EQ(ring(0.995), 998);
+  EXPECT_NEAR(a.front_p995, ring(0.995) * 1e-3, tol);
+  EXPECT_NEAR(a.front_p99, ring(0.99) * 1e-3, tol);
+  EXPECT_NEAR(a.front_p999, ring(0.999) * 1e-3, tol);
+  EXPECT_NEAR(a.width_p995, 2 * (ring(0.995) - 0.5) * dr, tol);
+  EXPECT_NEAR(a.width_max, 2 * (N - 0.5) * dr, tol);
+  EXPECT_NEAR(a.front_max, N * 1e-3, tol);
+
+  // The impact axis of an axisymmetric scene is y.
+  DebrisOptions along_x;
+  along_x.axis = 0;
+  EXPECT_THROW(DebrisMeter(scene, start.frame(0), along_x), InputError);
+  // Rings without masses cannot be weighed.
+  later.m.clear();
+  EXPECT_THROW(meter.measure(later.frame(30e-6)), InputError);
 }
 
 // Friends of friends: points closer than the linking length are one fragment, transitively,

@@ -754,6 +754,57 @@ TEST(Voxelise, ParticleSpacingInTwoDimensionsAndAxisymmetric) {
   }
 }
 
+// Axisymmetric exact masses (per radian: the integral of r over the part at r >= 0) for bodies
+// that cross the axis, are rotated or scaled, against closed forms; the particles' masses
+// converge to them.
+TEST(Voxelise, AxisymmetricExactMassOfBodiesCrossingTheAxis) {
+  const double rho = 7850;
+  Scene s = make_scene(2, 0.01, Vec3(0, -0.5, 0), Vec3(1, 0.5, 0));
+  s.axisymmetric = true;
+  auto exact = [&](const BodySpec& b) {
+    s.bodies = {b};
+    return run(s).report[0];
+  };
+  // A disk centred on the axis is a sphere: 4/3 pi R^3 / (2 pi) = 2/3 R^3 per radian.
+  BodyReport r = exact(sphere("ball", 0.2, Vec3(0, 0, 0)));
+  EXPECT_NEAR(r.exact_mass, rho * 2.0 / 3.0 * 0.008, 1e-12);
+  EXPECT_NEAR(r.mass / r.exact_mass, 1.0, 0.01);
+  // Off the axis: Pappus, area times the centre's radius (a torus).
+  r = exact(sphere("torus", 0.1, Vec3(0.3, 0, 0)));
+  EXPECT_NEAR(r.exact_mass, rho * kPi * 0.01 * 0.3, 1e-12);
+  // Crossing the axis at a quarter of the radius: R = 0.2, centre at x = 0.05. With
+  // u = x - 0.05 from -0.05 to R: 0.05 (R^2 (pi/2 + asin(1/4)) + 0.05 sqrt(R^2 - 0.0025))
+  // + 2/3 (R^2 - 0.0025)^(3/2), the integral of (0.05 + u) 2 sqrt(R^2 - u^2).
+  r = exact(sphere("cut", 0.2, Vec3(0.05, 0, 0)));
+  const double q = 0.04 - 0.0025;
+  EXPECT_NEAR(r.exact_mass,
+              rho * (0.05 * (0.04 * (kPi / 2 + std::asin(0.25)) + 0.05 * std::sqrt(q)) + 2.0 / 3.0 * std::pow(q, 1.5)),
+              1e-12);
+  EXPECT_NEAR(r.mass / r.exact_mass, 1.0, 0.01);
+  // An ellipse (the disk scaled by 2 along x) centred on the axis: an oblate spheroid, 4/3 pi
+  // a^2 b / (2 pi) with a = 0.4, b = 0.2.
+  BodySpec e = sphere("spheroid", 0.2, Vec3(0, 0, 0));
+  e.scale = Vec3(2, 1, 1);
+  r = exact(e);
+  EXPECT_NEAR(r.exact_mass, rho * 2.0 / 3.0 * 0.16 * 0.2, 1e-12);
+  EXPECT_NEAR(r.mass / r.exact_mass, 1.0, 0.01);
+  // A box from x = -0.2 to 0.6, 0.3 high: the integral of x over 0 .. 0.6, times 0.3.
+  r = exact(box("slab", Vec3(0.8, 0.3, 0), Vec3(0.2, 0, 0)));
+  EXPECT_NEAR(r.exact_mass, rho * 0.18 * 0.3, 1e-12);
+  EXPECT_NEAR(r.mass / r.exact_mass, 1.0, 1e-12);  // the lattice tiles the part at x >= 0
+  // A square of side 0.2 rotated by 45 degrees about its centre on the axis: the half at x >= 0
+  // is a triangle of apex 0.1 sqrt(2), area 0.02, its centroid at 0.1 sqrt(2) / 3.
+  BodySpec d = box("diamond", Vec3(0.2, 0.2, 0), Vec3(0, 0, 0));
+  d.rotate_deg = Vec3(0, 0, 45);
+  r = exact(d);
+  EXPECT_NEAR(r.exact_mass, rho * 0.02 * 0.1 * std::sqrt(2.0) / 3.0, 1e-12);
+  EXPECT_NEAR(r.mass / r.exact_mass, 1.0, 0.03);  // staircase edges: spacing 0.005 / apex 0.14
+  // Rotated and wholly off the axis: Pappus again.
+  d.translate = Vec3(0.5, 0, 0);
+  r = exact(d);
+  EXPECT_NEAR(r.exact_mass, rho * 0.04 * 0.5, 1e-12);
+}
+
 TEST(Voxelise, BodyOutsideTheDomainOrTooThinIsRefused) {
   Scene s = make_scene(3, 0.1, Vec3::Zero(), Vec3::Ones());
   BodySpec far = sphere("far", 0.2, Vec3(5, 5, 5));
