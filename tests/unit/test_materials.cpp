@@ -270,6 +270,25 @@ TEST(Materials, FailedPointsSignalSpeedHasNoShearAndNoExpansionBlowUp) {
     EXPECT_EQ(p.sigma.norm(), 0.0);
     EXPECT_NEAR(p.c, c_bulk0, 1e-6 * c_bulk0) << "rho / rho0 = " << ratio;
   }
+  // Debris expanded thousands of times and being recompressed (the bulk viscosity acts): its
+  // sound speed is still c0 (p = rho0 c0^2 mu has rho dp/drho = rho c0^2), widened by the
+  // viscosity Q = C1 c + C0 h |tr D| of the update, not a speed growing like rho^-1/2.
+  {
+    SolverSpec bulk;
+    bulk.bulk_linear = 0.06;
+    bulk.bulk_quadratic = 1.5;
+    const Material visc(spec, bulk);
+    for (const double ratio : {0.2, 1e-2, 2e-4}) {
+      Point d(spec.density * ratio);
+      d.failed = 1;
+      d.e = 2e6;
+      const double trD = -1e5;
+      d.update(visc, Mat3::Identity() * (trD / 3), 1e-9, false, true);
+      const double Q = 0.06 * c_bulk0 + 1.5 * 1e-3 * (-trD);  // h = 1 mm (Point)
+      const double widened = Q + std::sqrt(Q * Q + c_bulk0 * c_bulk0);
+      EXPECT_NEAR(d.c, widened, 1e-3 * widened) << "rho / rho0 = " << ratio;
+    }
+  }
   Point p(spec.density * 1.1);
   p.failed = 1;
   p.e = 1e5;

@@ -54,7 +54,11 @@ class MieGruneisenEos final : public Eos {
         K[i] = (1.0 + mu) * std::max(dpH * g + pH * dg, k0);
       } else {
         A[i] = k0 * mu;
-        K[i] = k0 * std::max(1.0 + mu, 0.05);
+        // rho dA/drho = k0 rho / rho0: c = c0 at any expansion. (A floor under it, as there
+        // was, makes c grow like rho^-1/2 in debris expanded thousands of times, 20-40 km/s in
+        // V4's cloud at rho0 / 5000, and that set the time step whenever such debris was
+        // recompressed.)
+        K[i] = k0 * (1.0 + mu);
         if (!energy_in_expansion_) B[i] = 0.0;  // p = rho0 c0^2 mu only
       }
     }
