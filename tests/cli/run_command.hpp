@@ -2,9 +2,11 @@
 // Runs a shell command for the CLI tests, capturing its exit status, stdout and stderr.
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 
@@ -40,6 +42,14 @@ inline Result run(const std::string& cmd, const std::filesystem::path& dir) {
   r.out = slurp(out);
   r.err = slurp(err);
   return r;
+}
+
+/// The number after "key": in a tool's --json output; NaN when the key is absent.
+inline double json_value(const std::string& json, const std::string& key) {
+  std::smatch m;
+  const std::regex re("\"" + key + "\": ([-0-9.eE+]+)");
+  if (!std::regex_search(json, m, re)) return NAN;
+  return std::stod(m[1]);
 }
 
 inline const std::string prep = MPM_PREP;

@@ -2,7 +2,6 @@
 // authors' code at the same resolution (reference values and tolerance in taylor_bar.toml).
 #include <gtest/gtest.h>
 
-#include <regex>
 #include <toml++/toml.h>
 
 #include "cli/run_command.hpp"
@@ -12,13 +11,6 @@ namespace {
 
 using namespace mpm::testing;
 namespace fs = std::filesystem;
-
-double json_value(const std::string& json, const std::string& key) {
-  std::smatch m;
-  const std::regex re("\"" + key + "\": ([-0-9.eE+]+)");
-  if (!std::regex_search(json, m, re)) return NAN;
-  return std::stod(m[1]);
-}
 
 TEST(Regression, TaylorBarCoarse) {
   const auto dir = temp_dir("taylor_coarse");
