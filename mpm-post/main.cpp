@@ -641,6 +641,7 @@ int cmd_profile(const std::string& path, ProfileArgs& a) {
 // render ----------------------------------------------------------------------------------
 struct RenderArgs {
   std::string output = "frame.png", frame = "last", time, size = "1200x900", range;
+  bool half = false;
   RenderOptions opt;
 };
 
@@ -661,9 +662,11 @@ int cmd_render(const std::string& path, RenderArgs& a) {
   std::optional<double> at;
   if (!a.time.empty()) at = quantity(a.time, dim::time, "--time");
   std::optional<Frame> chosen;
+  std::optional<Scene> scene;
   long index = 0;
   double best = 1e300;
   StreamVisitor v;
+  v.scene = [&](const std::string& t) { scene = scene_of(t, path); };
   v.frame = [&](Frame&& f) {
     const long k = index++;
     if (at) {
@@ -680,6 +683,8 @@ int cmd_render(const std::string& path, RenderArgs& a) {
     return kExitBadInput;
   }
   const int dim = chosen->columns.at("x").info().components;
+  o.axisymmetric = scene && scene->axisymmetric && dim == 2;
+  o.mirror = o.axisymmetric && !a.half;  // the whole section through the axis
   render_png(*chosen, dim, o, a.output);
   // The time in us for impact runs, in s for slow ones (forming, the dimensionless V7 scenes).
   const bool slow = chosen->time >= 1e-2;
@@ -798,6 +803,9 @@ int main(int argc, char** argv) {
   render->add_option("--range", ra.range, "colour range MIN:MAX (SI units)");
   render->add_option("--title", ra.opt.title, "title text");
   render->add_option("--radius", ra.opt.point_radius, "particle radius in m (default from mass and density)");
+  render->add_flag("--half", ra.half,
+                   "axisymmetric frames: draw the half plane r >= 0 only (default: the whole section, mirrored "
+                   "about the axis)");
 
   try {
     app.parse(argc, argv);

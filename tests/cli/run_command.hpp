@@ -56,4 +56,12 @@ inline const std::string prep = MPM_PREP;
 inline const std::string runner = MPM_RUN;
 inline const std::string post = MPM_POST;
 
+/// `mpm-prep SCENE PREP_ARGS | mpm-run --progress none -o OUT`, run in `dir`.
+inline Result prep_and_run(const std::filesystem::path& scene, const std::string& prep_args,
+                           const std::filesystem::path& out, const std::filesystem::path& dir) {
+  return run(prep + " " + scene.string() + " " + prep_args + " | " + runner + " --progress none -o " +
+                 out.string(),
+             dir);
+}
+
 }  // namespace mpm::testing

@@ -27,11 +27,9 @@ namespace fs = std::filesystem;
 
 TEST(Regression, HypervelocityAxisymmetricCloud) {
   const auto dir = temp_dir("hv_axisym");
-  const fs::path scene = fs::path(MPM_EXAMPLES) / "hypervelocity" / "axisym.toml";
   const fs::path out = dir / "axi.mpm";
-  Result r = run(prep + " " + scene.string() + " --set \"grid.cell_size=1.06 mm\" | " + runner +
-                     " --progress none -o " + out.string(),
-                 dir);
+  Result r = prep_and_run(fs::path(MPM_EXAMPLES) / "hypervelocity" / "axisym.toml",
+                          "--set \"grid.cell_size=1.06 mm\"", out, dir);
   ASSERT_EQ(r.status, 0) << r.err;
   r = run(post + " debris " + out.string() + " --time \"30.6 us\" --json", dir);
   ASSERT_EQ(r.status, 0) << r.err;

@@ -511,11 +511,13 @@ vtkSmartPointer<vtkLookupTable> viridis_table(double lo, double hi) {
   return lut;
 }
 
-/// Particle radius: 0.5 x the edge of the median particle's volume (2D: area per 1 m).
-double estimate_radius(const Frame& frame, int dim, const std::vector<std::uint32_t>& keep,
+/// Particle radius: 0.5 x the edge of the median particle's volume (2D: area per 1 m;
+/// axisymmetric: m / (rho r), the mass being per radian).
+double estimate_radius(const Frame& frame, int dim, bool axisymmetric, const std::vector<std::uint32_t>& keep,
                        const double bounds[6]) {
   const Column* m = frame.columns.find("m");
   const Column* rho = frame.columns.find("rho");
+  const Column& x = frame.columns.at("x");
   if (m && rho && m->info().components == 1 && rho->info().components == 1) {
     const std::size_t n = frame.columns.size();
     const std::size_t samples = std::min<std::size_t>(n, 100001);
@@ -526,7 +528,7 @@ double estimate_radius(const Frame& frame, int dim, const std::vector<std::uint3
     };
     for (std::size_t s = 0; s < samples; ++s) {
       const std::size_t i = samples == n ? s : s * (n - 1) / (samples - 1);
-      const double v = get(*m, i) / get(*rho, i);
+      const double v = get(*m, i) / get(*rho, i) / (axisymmetric ? std::abs(position(x, i)[0]) : 1.0);
       if (std::isfinite(v) && v > 0) vol.push_back(v);
     }
     if (!vol.empty()) {
@@ -832,6 +834,8 @@ void render_png(const Frame& frame, int dim, const RenderOptions& options, const
     if (keep.empty()) throw InputError("render", "clip '" + options.clip + "' leaves no particles");
   }
   const std::size_t nk = keep.size();
+  if (options.mirror && dim != 2) throw InputError("render", "mirroring is for 2D (axisymmetric) frames");
+  const std::size_t np = options.mirror ? 2 * nk : nk;  // mirrored copies after the particles
 
   // Colour range: given, else the field's finite min..max over the frame.
   double lo = options.range_min, hi = options.range_max;
@@ -849,10 +853,10 @@ void render_png(const Frame& frame, int dim, const RenderOptions& options, const
   // Poly data of the kept particles: float positions and the field as scalars.
   vtkNew<vtkFloatArray> xyz;
   xyz->SetNumberOfComponents(3);
-  xyz->SetNumberOfTuples(vtkIdType(nk));
+  xyz->SetNumberOfTuples(vtkIdType(np));
   vtkNew<vtkFloatArray> scalars;
   scalars->SetName(field.label.c_str());
-  scalars->SetNumberOfTuples(vtkIdType(nk));
+  scalars->SetNumberOfTuples(vtkIdType(np));
   float* pxyz = xyz->GetPointer(0);
   float* ps = scalars->GetPointer(0);
 #pragma omp parallel for schedule(static)
@@ -860,16 +864,21 @@ void render_png(const Frame& frame, int dim, const RenderOptions& options, const
     const auto p = position(x, keep[j]);
     pxyz[3 * j] = float(p[0]), pxyz[3 * j + 1] = float(p[1]), pxyz[3 * j + 2] = float(p[2]);
     ps[j] = field.values[keep[j]];
+    if (np > nk) {
+      float* q = pxyz + 3 * (nk + j);
+      q[0] = -float(p[0]), q[1] = float(p[1]), q[2] = float(p[2]);
+      ps[nk + j] = ps[j];
+    }
   }
   double bounds[6] = {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
                       std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
                       std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
-  for (std::size_t j = 0; j < nk; ++j)
+  for (std::size_t j = 0; j < np; ++j)
     for (int a = 0; a < 3; ++a)
       bounds[2 * a] = std::min(bounds[2 * a], double(pxyz[3 * j + a])),
                  bounds[2 * a + 1] = std::max(bounds[2 * a + 1], double(pxyz[3 * j + a]));
   const double radius =
-      options.point_radius > 0 ? options.point_radius : estimate_radius(frame, dim, keep, bounds);
+      options.point_radius > 0 ? options.point_radius : estimate_radius(frame, dim, options.axisymmetric, keep, bounds);
 
   vtkNew<vtkPoints> points;
   points->SetData(xyz);

@@ -45,6 +45,10 @@ struct RenderOptions {
   double point_radius = 0;      ///< m; 0: estimated from particle mass and density
   std::string clip;             ///< "", "y>0" ...: keep particles on one side of a plane through the centroid
                                 ///< ("y>0.002" or "y>2mm": a plane that far from the centroid)
+  bool axisymmetric = false;    ///< 2D frame of an axisymmetric scene: a particle's mass is per
+                                ///< radian, its area m / (rho r) (for the automatic radius)
+  bool mirror = false;          ///< 2D: draw each particle also at (-x, y): an axisymmetric frame's
+                                ///< whole section through the axis
 };
 
 /// Renders a frame to a PNG off-screen, particles as spheres coloured by a field (viridis)
