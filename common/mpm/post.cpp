@@ -136,12 +136,11 @@ double percentile(std::vector<double> v, double p) {
 }
 
 /// p-th percentile (0..100) of values weighted by w (> 0): the smallest value whose cumulative
-/// weight, in ascending order of the values, reaches p / 100 of the total. With equal weights
-/// it is the nearest-rank percentile above, which is then used as is (sums of many equal
+/// weight, in ascending order of the values, reaches p / 100 of the total. For unequal weights:
+/// with equal ones the nearest-rank percentile above is the same and exact (sums of many equal
 /// weights round, and would move a rank that falls on a whole number).
 double percentile(const std::vector<double>& v, const std::vector<double>& w, double p) {
   if (v.empty()) return 0;
-  if (std::all_of(w.begin(), w.end(), [&](double x) { return x == w[0]; })) return percentile(v, p);
   std::vector<std::size_t> order(v.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return v[a] < v[b]; });
@@ -343,14 +342,17 @@ DebrisResult DebrisMeter::measure(const Frame& frame) const {
   r.by_mass = !std::all_of(mass.begin(), mass.end(), [&](double w) { return w == mass[0]; });
   r.front_max = *std::max_element(front.begin(), front.end());
   r.width_max = *std::max_element(width.begin(), width.end());
-  r.front_p99 = percentile(front, mass, 99);
-  r.front_p995 = percentile(front, mass, 99.5);
-  r.front_p999 = percentile(front, mass, 99.9);
-  r.width_p99 = percentile(width, mass, 99);
-  r.width_p995 = percentile(width, mass, 99.5);
-  r.width_p999 = percentile(width, mass, 99.9);
-  r.front = percentile(front, mass, opt_.percentile);
-  r.width = percentile(width, mass, opt_.percentile);
+  const auto pct = [&](const std::vector<double>& v, double p) {
+    return r.by_mass ? percentile(v, mass, p) : percentile(v, p);
+  };
+  r.front_p99 = pct(front, 99);
+  r.front_p995 = pct(front, 99.5);
+  r.front_p999 = pct(front, 99.9);
+  r.width_p99 = pct(width, 99);
+  r.width_p995 = pct(width, 99.5);
+  r.width_p999 = pct(width, 99.9);
+  r.front = pct(front, opt_.percentile);
+  r.width = pct(width, opt_.percentile);
   return r;
 }
 

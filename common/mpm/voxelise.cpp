@@ -140,11 +140,11 @@ class PrimitiveRegion final : public Region {
 
   double revolved_volume() const override {
     if (dim_ != 2) return Region::revolved_volume();
-    const double detA = std::abs(A_(0, 0) * A_(1, 1) - A_(0, 1) * A_(1, 0));
     if (kind_ == ShapeKind::Sphere) {
       // The ellipse {A u + t : |u| <= R}: x = a.u + t_x with a the first row of A. With w the
       // coordinate of u along a, the integral of x over x >= 0 is |det A| times the integral
       // of (|a| w + t_x) 2 sqrt(R^2 - w^2) over w from max(-R, -t_x / |a|) to R.
+      const double detA = std::abs(A_(0, 0) * A_(1, 1) - A_(0, 1) * A_(1, 0));
       const double R = std::sqrt(r2_), alpha = std::hypot(A_(0, 0), A_(0, 1));
       const double w0 = std::clamp(-t_.x() / alpha, -R, R);
       auto root = [&](double w) { return std::sqrt(std::max(0.0, (R - w) * (R + w))); };  // 0 at w = +-R
@@ -406,10 +406,9 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
     const Region& region = *regions[b];
     const MeshRegion* mesh = dynamic_cast<const MeshRegion*>(&region);
     BodyPlan& P = plans[b];
-    // Spacing: particle_spacing, else h / particles_per_cell.
     const bool by_spacing = body.particle_spacing > 0;
     const int n = body.particles_per_cell;
-    const double s = by_spacing ? body.particle_spacing : h / n;
+    const double s = body.spacing(h);
     P.spacing = s;
     P.particle_volume = dim == 3 ? s * s * s : s * s * 1.0;  // 2D: 1 m thick (or per radian, times r)
     P.mass = density_of(scene, body) * P.particle_volume;
