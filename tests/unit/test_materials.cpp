@@ -252,6 +252,31 @@ TEST(Materials, SignalSpeedIsTheIsentropicSoundSpeed) {
   }
 }
 
+// The linear EOS p = K (rho / rho0 - 1) has rho dp/drho = K rho / rho0: its signal speed is
+// sqrt((K rho / rho0 + 4/3 G) / rho) at any density, measured here as above by a tiny
+// isotropic compression of a point compressed by 20% and of one expanded by 20%. (It reported
+// K itself, c^2 = (K + 4/3 G) / rho: 4.5% under the true speed's bulk part at 1.2 rho0.)
+TEST(Materials, LinearEosSignalSpeedIsItsSoundSpeedAtAnyDensity) {
+  MaterialSpec spec = copper();
+  spec.strength.model = StrengthModel::Elastic;
+  const Material mat(spec, no_viscosity());
+  const double G = spec.youngs_modulus / (2 * (1 + spec.poisson_ratio));
+  const double K = spec.bulk_modulus();
+  for (const double ratio : {1.2, 0.8}) {
+    Point p(spec.density * ratio);
+    const double dt = 1e-9;
+    const Mat3 L = Mat3::Identity() * (-1e2 / 3.0);
+    p.update(mat, L, dt);
+    const double p1 = -trace(p.sigma) / 3, rho1 = p.rho;
+    p.update(mat, L, dt);
+    const double p2 = -trace(p.sigma) / 3, rho2 = p.rho;
+    const double K_s = rho2 * (p2 - p1) / (rho2 - rho1);
+    EXPECT_NEAR(K_s, K * rho2 / spec.density, 1e-5 * K) << "rho / rho0 " << ratio;
+    const double c_s = std::sqrt((K_s + 4.0 / 3.0 * G) / rho2);
+    EXPECT_NEAR(p.c, c_s, 1e-4 * c_s) << "rho / rho0 " << ratio;
+  }
+}
+
 // A failed point carries no shear stress, and in expansion (pressure clamped at zero) no stress
 // at all: its signal speed has no shear term, and expanded far below rho0 it is the EOS's bulk
 // speed at rho0 (where waves start again on recompression), not sqrt(K / rho) of a density

@@ -9,7 +9,9 @@ namespace mpm {
 
 namespace {
 
-/// p = K mu, mu = rho/rho0 - 1; no dependence on internal energy.
+/// p = K mu, mu = rho/rho0 - 1; no dependence on internal energy. The bulk modulus it reports
+/// is rho dp/drho = K rho / rho0, so c^2 = K / rho0 at any density (as for the
+/// Mie-Grueneisen's expansion branch); K alone gave c^2 = K / rho, c too low in compression.
 class LinearEos final : public Eos {
  public:
   explicit LinearEos(const MaterialSpec& m) : rho0_(m.density), K_(m.bulk_modulus()) {}
@@ -17,7 +19,7 @@ class LinearEos final : public Eos {
     for (int i = 0; i < n; ++i) {
       A[i] = K_ * (rho[i] / rho0_ - 1.0);
       B[i] = 0.0;
-      K[i] = K_;
+      K[i] = K_ * rho[i] / rho0_;
     }
   }
 
