@@ -116,6 +116,7 @@ class ImplicitSolver {
   void force_trial(Trial& t);   // f_i^L from the trial stress
   void residual(const nk::Vector& u, const Trial& t, nk::Vector& F) const;
   bool folds(const std::vector<Vec<D>>& v) const;  // Lagrangian step restriction
+  bool crosses_axis(const nk::Vector& u) const;    // axisymmetry: a particle would reach r < 0
   void reactions(const nk::Vector& u);             // forces on rigid bodies and faces
   void commit(const nk::Vector& u);                // particles: v, x, stress state; energies
 
