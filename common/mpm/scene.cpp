@@ -1020,8 +1020,9 @@ void read_implicit(Reader& r, ImplicitSpec& m) {
                   .value_or(Forcing::EisenstatWalker);
   m.preconditioner = r.choice<Preconditioner>(
                           "preconditioner",
-                          {{"none", Preconditioner::None}, {"diagonal", Preconditioner::Diagonal}})
-                         .value_or(m.formulation == Formulation::Velocity ? Preconditioner::Diagonal
+                          {{"none", Preconditioner::None}, {"diagonal", Preconditioner::Diagonal},
+                           {"tangent", Preconditioner::Tangent}})
+                         .value_or(m.formulation == Formulation::Velocity ? Preconditioner::Tangent
                                                                           : Preconditioner::None);
   m.initial_guess = r.choice<InitialGuess>("initial_guess", {{"particles", InitialGuess::Particles},
                                                              {"previous", InitialGuess::Previous}})

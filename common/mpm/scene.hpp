@@ -167,9 +167,10 @@ enum class Forcing { Fixed, EisenstatWalker };
 /// Newton's initial guess: the grid velocities (or momenta) from the particles, v^k (001,
 /// Algorithm 1), or the previous step's converged grid velocities where a node had them.
 enum class InitialGuess { Particles, Previous };
-/// Preconditioner of the Krylov solve: none, or the Jacobian's diagonal estimated from the
-/// lumped mass and the elastic stiffness.
-enum class Preconditioner { None, Diagonal };
+/// Preconditioner of the Krylov solve: none; the Jacobian's diagonal estimated from the
+/// lumped mass and the elastic stiffness; or the whole tangent M + theta dt^2 K_t (the
+/// elastic-plastic stiffness of the particles at the step's start), assembled and factored.
+enum class Preconditioner { None, Diagonal, Tangent };
 
 /// The implicit solver (001, sections 2.4 and 3.2): the theta-scheme of eq. 2.4.1 solved by
 /// matrix-free Newton-Krylov with a backtracking line search. Defaults are the seed's.

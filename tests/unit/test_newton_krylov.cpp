@@ -64,7 +64,8 @@ TEST(Krylov, ConjugateGradientsSolveSpdSystem) {
   EXPECT_LT((b - A * x).norm(), 1e-10 * b.norm() * 1.0001);
   // The diagonal preconditioner removes the spread of the diagonal: far fewer iterations.
   const Vector inv_diag = A.diagonal().cwiseInverse();
-  const nk::LinearReport pre = nk::cg(apply(A), b, x, 1e-10, 500, &inv_diag);
+  const nk::Preconditioner diag = nk::diagonal_preconditioner(inv_diag);
+  const nk::LinearReport pre = nk::cg(apply(A), b, x, 1e-10, 500, &diag);
   ASSERT_TRUE(pre.converged);
   EXPECT_LT((x - exact).norm(), 1e-8 * exact.norm());
   EXPECT_LT(pre.iterations, plain.iterations / 2) << pre.iterations << " vs " << plain.iterations;
@@ -86,7 +87,8 @@ TEST(Krylov, GmresSolvesNonsymmetricSystem) {
   EXPECT_NEAR((b - A * x).norm() / b.norm(), r.relative_residual, 1e-12);
   // A small basis with restarts, right-preconditioned, reaches the same answer.
   const Vector inv_diag = A.diagonal().cwiseInverse();
-  r = nk::gmres(apply(A), b, x, 1e-12, 5, 50, &inv_diag);
+  const nk::Preconditioner diag = nk::diagonal_preconditioner(inv_diag);
+  r = nk::gmres(apply(A), b, x, 1e-12, 5, 50, &diag);
   ASSERT_TRUE(r.converged);
   EXPECT_LT((x - exact).norm(), 1e-10 * exact.norm());
   // One basis of 5 without restarts stops short but still reduces the residual.

@@ -63,11 +63,11 @@ TEST(SceneImplicit, DefaultsAreTheSeeds) {
   EXPECT_EQ(m.ramp, 0.2);              // Tables 1-6: 20% a step
   EXPECT_EQ(m.dt_initial_multiple, 1.0);
   EXPECT_EQ(m.forcing, Forcing::EisenstatWalker);     // beyond the seed: measured to win
-  EXPECT_EQ(m.preconditioner, Preconditioner::None);  // with GMRES: measured to lose
+  EXPECT_EQ(m.preconditioner, Preconditioner::None);  // GMRES: the tangent is an option
   EXPECT_EQ(m.initial_guess, InitialGuess::Particles);  // the seed's v^k: with GMRES, wins
   const Scene v = parse("type = \"implicit\"\n", {"solver.implicit.formulation=velocity"});
   EXPECT_EQ(v.solver.implicit.krylov, KrylovMethod::CG);
-  EXPECT_EQ(v.solver.implicit.preconditioner, Preconditioner::Diagonal);  // with CG: wins
+  EXPECT_EQ(v.solver.implicit.preconditioner, Preconditioner::Tangent);  // with CG: wins
   EXPECT_EQ(v.solver.implicit.initial_guess, InitialGuess::Previous);       // with CG: wins
 }
 

@@ -63,7 +63,7 @@ Scene implicit(Scene s, Formulation f, double theta = 1.0) {
   s.solver.implicit.formulation = f;
   s.solver.implicit.krylov = f == Formulation::Velocity ? KrylovMethod::CG : KrylovMethod::GMRES;
   s.solver.implicit.preconditioner =  // the scene's defaults
-      f == Formulation::Velocity ? Preconditioner::Diagonal : Preconditioner::None;
+      f == Formulation::Velocity ? Preconditioner::Tangent : Preconditioner::None;
   s.solver.implicit.theta = theta;
   return s;
 }
@@ -128,6 +128,53 @@ TEST(Implicit, MatrixFreeProductMatchesFiniteDifferenceJacobian) {
           EXPECT_GT(asym, 1e-2);
       }
     }
+  }
+}
+
+// The tangent preconditioner (preconditioner = "tangent") on a linear elastic step is the
+// Jacobian's inverse: P^-1 J = I up to what the assembled tangent leaves out, the geometric
+// terms of the step (its strain increments are about 1% here: measured 3e-3 to 6e-3, so 1e-2)
+// and, with stress, the stress's own stiffness (sigma / E ~ 1e-3). J is the central-difference Jacobian of the step's residual; P^-1 applied
+// to its columns. Velocity formulation: P^-1 = scale (M + dt^2 K)^-1, symmetric positive
+// definite (CG); momentum: P^-1 = scale (I + dt^2 K M^-1 M_c M^-1)^-1, the remap of eq. 3.2.7
+// included. At the explicit step (dt^2 K < M) the diagonal stands in for it.
+TEST(Implicit, TangentPreconditionerInvertsTheJacobianOfALinearElasticStep) {
+  for (Formulation f : {Formulation::Velocity, Formulation::Momentum}) {
+    SCOPED_TRACE(f == Formulation::Velocity ? "velocity" : "momentum");
+    Model m = pulled_bar(0.002);
+    Scene sc = implicit(m.scene, f);
+    sc.solver.implicit.preconditioner = Preconditioner::Tangent;
+    ImplicitSolver<UniformGrid<2>> solver(sc, UniformGrid<2>(m.lat, m.scene.boundary), m.cols);
+    const double dt = 100 * solver.explicit_dt();
+    for (int stressed = 0; stressed < 2; ++stressed) {
+      if (stressed) solver.step(dt);
+      nk::Vector u;
+      nk::NonlinearSystem& sys = solver.system_for(dt, u);
+      const Eigen::Index n = u.size();
+      ASSERT_TRUE(bool(solver.preconditioner()));
+      EXPECT_EQ(solver.inverse_diagonal().size(), n);  // built too: the fallback
+      const Eigen::MatrixXd J =
+          fd_jacobian(sys, u, 1e-4 * solver.typical_unknown_norm() / std::sqrt(double(n)));
+      Eigen::MatrixXd PJ(n, n);
+      nk::Vector z(n);
+      for (Eigen::Index j = 0; j < n; ++j) {
+        solver.preconditioner()(J.col(j), z);
+        PJ.col(j) = z;
+      }
+      const double err = (PJ - Eigen::MatrixXd::Identity(n, n)).norm() / std::sqrt(double(n));
+      EXPECT_LT(err, 1e-2) << "stressed " << stressed;
+      // Without it the same Jacobian is far from the identity: the test can fail.
+      const double plain = (J * (1.0 / J.diagonal().mean()) - Eigen::MatrixXd::Identity(n, n)).norm() /
+                           std::sqrt(double(n));
+      EXPECT_GT(plain, 0.5);
+      std::printf("tangent preconditioner, %s, stressed %d: |P^-1 J - I| / sqrt(n) = %.2e (plain %.2f)\n",
+                  f == Formulation::Velocity ? "velocity" : "momentum", stressed, err, plain);
+    }
+    // At the explicit step the stiffness does not outweigh the mass: the diagonal (velocity)
+    // or nothing (momentum) is used.
+    nk::Vector u;
+    solver.system_for(solver.explicit_dt(), u);
+    EXPECT_EQ(bool(solver.preconditioner()), f == Formulation::Velocity);
   }
 }
 
@@ -373,7 +420,9 @@ TEST(Implicit, RigidAndFaceForcesBalanceTheMomentum) {
                solver.residual_scale(solver.last_dt());
     }
     const Vec3 dp = solver.balance().momentum - p0;
-    EXPECT_GT(solver.rigid_force()[1].x(), 0.0);  // the bar holds the puller back (+x)
+    // The bar held the puller back (+x) while it was brought to the puller's speed; by t = 2
+    // it moves with it and the force is round-off (|F| < 1e-10 against 0.05 at the start).
+    EXPECT_GT(impulse.x(), 0.0);
     EXPECT_LT((dp + impulse).norm(), bound) << dp.transpose() << " vs " << impulse.transpose();
     EXPECT_LT((dp + impulse).norm(), 1e-5 * impulse.norm());
   }

@@ -6,6 +6,9 @@
 #include <omp.h>
 
 #include <Eigen/LU>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -372,13 +375,19 @@ bool ImplicitSolver<GridT>::attempt(double dt) {
   S.max_line_search = spec_.max_line_search;
   S.forcing = spec_.forcing;
   const double t0 = omp_get_wtime(), e0 = system_->seconds;
-  const nk::Report rep = nk::solve(system, u, S, inv_diag_.size() ? &inv_diag_ : nullptr, u_typ_);
+  const nk::Report rep = nk::solve(system, u, S, precond_ ? &precond_ : nullptr, u_typ_);
   timers_.add(timers_.id("newton_krylov"), omp_get_wtime() - t0 - (system_->seconds - e0));
   last_work_.newton += rep.work.newton;
   last_work_.krylov += rep.work.krylov;
   last_work_.evaluations += rep.work.evaluations;
   last_work_.line_search_cuts += rep.work.line_search_cuts;
   last_residuals_ = rep.residuals;
+  if (tangent_ && spec_.preconditioner == Preconditioner::Tangent) {
+    Tangent& T = *tangent_;
+    T.last_rate = rep.work.newton > 0 ? double(rep.work.krylov) / double(rep.work.newton) : 0.0;
+    if (T.fresh_rate < 0) T.fresh_rate = T.last_rate;
+    if (!rep.converged()) T.valid = false;
+  }
   if (rep.outcome == nk::Outcome::InadmissibleStart) {  // the guess folds a particle's
     ++last_work_.lagrangian_cuts;                       // neighbourhood: det(I + dt L) <= 0
     return false;
@@ -449,18 +458,212 @@ nk::NonlinearSystem& ImplicitSolver<GridT>::system_for_current(double dt, nk::Ve
   u_typ_ = std::sqrt(typ2);
   // Diagonal preconditioner: the Jacobian of the dimensionless residual is about
   // (M + theta dt^2 K) / scale (velocity) or (I + theta dt^2 K M^-1) / scale (momentum).
+  // The tangent preconditioner only when the stiffness outweighs the mass (theta dt^2 sum
+  // K_ii > sum m_i): below that J is close to its diagonal (at the explicit step the ratio is
+  // about cfl^2; single nodes of tiny mass exceed it at any step).
   inv_diag_.resize(0);
-  if (spec_.preconditioner == Preconditioner::Diagonal) {
+  precond_ = nullptr;
+  bool tangent = false;
+  if (spec_.preconditioner != Preconditioner::None) {
     inv_diag_.resize(Eigen::Index(nd));
     const double th = spec_.theta;
+    double stiffness = 0, mass = 0;
     for (std::size_t d = 0; d < nd; ++d) {
       const std::int64_t n = dof_node_[d];
       const double m = grid_.m[n], k = k_diag_[n][dof_axis_[d]];
+      stiffness += th * dt * dt * k;
+      mass += m;
       const double j = momentum ? 1.0 + th * dt * dt * k / m : m + th * dt * dt * k;
       inv_diag_[d] = scale / j;
     }
+    tangent = spec_.preconditioner == Preconditioner::Tangent && stiffness > mass && tangent_for(dt);
+    // Without it the diagonal, which helps CG and not GMRES (docs/scene.md): the momentum
+    // formulation's J is then about the identity.
+    if (!tangent && (spec_.preconditioner == Preconditioner::Diagonal || !momentum))
+      precond_ = nk::diagonal_preconditioner(inv_diag_);
+  }
+  if (tangent) {
+    // J ~ (M + theta dt^2 K_t) / scale (velocity) or (I + theta dt^2 K_t W) / scale
+    // (momentum, W = M^-1 M_c M^-1): P^-1 r = scale times the factor's solve.
+    Tangent& T = *tangent_;
+    precond_ = [&T, scale, momentum](const nk::Vector& r, nk::Vector& z) {
+      if (momentum)
+        z = T.lu.solve(r);
+      else
+        z = T.ldlt.solve(r);
+      z *= scale;
+    };
   }
   return *system_;
+}
+
+/// The tangent preconditioner's factored matrix.
+template <class GridT>
+struct ImplicitSolver<GridT>::Tangent {
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;  ///< velocity: M + theta dt^2 K_t
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;  ///< momentum: I + theta dt^2 K_t W
+  std::vector<std::int64_t> dof_of;  ///< node * D + component -> unknown, -1 if prescribed
+  /// What the factor was built for: the unknowns (global node and component) and dt; and the
+  /// Krylov iterations per Newton iteration of the first solve with it, and of the last.
+  std::vector<std::int64_t> keys;
+  double dt = 0, fresh_rate = -1, last_rate = 0;
+  bool valid = false;
+  std::vector<Eigen::Triplet<double>> entries;
+  /// The sparsity pattern the factor was analysed for: the ordering is reused while the
+  /// pattern stays (the same unknowns, the particles in the same cells), only refactored.
+  std::vector<int> outer, inner;
+  template <class Solver>
+  bool factor(Solver& solver, Eigen::SparseMatrix<double>& A) {
+    A.makeCompressed();
+    const int* o = A.outerIndexPtr();
+    const int* in = A.innerIndexPtr();
+    const bool same = outer.size() == std::size_t(A.outerSize() + 1) &&
+                      inner.size() == std::size_t(A.nonZeros()) &&
+                      std::equal(outer.begin(), outer.end(), o) &&
+                      std::equal(inner.begin(), inner.end(), in);
+    if (!same) {
+      solver.analyzePattern(A);
+      outer.assign(o, o + A.outerSize() + 1);
+      inner.assign(in, in + A.nonZeros());
+    }
+    solver.factorize(A);
+    if (solver.info() == Eigen::Success) return true;
+    outer.clear();  // analyse again next time
+    return false;
+  }
+};
+
+/// The tangent preconditioner for a step dt: the last factor while it was built for the same
+/// unknowns and dt and still works (the last solve took at most 1.5 times the Krylov
+/// iterations per Newton iteration of the first solve with it, plus one), else a new one.
+/// The tangent changes little from step to step at small multiples, where a factor per step
+/// would cost more than the Krylov iterations it saves.
+template <class GridT>
+bool ImplicitSolver<GridT>::tangent_for(double dt) {
+  std::vector<std::int64_t> keys(dof_node_.size());
+  for (std::size_t d = 0; d < keys.size(); ++d) keys[d] = global_key(dof_node_[d]) * D + dof_axis_[d];
+  if (tangent_ && tangent_->valid && tangent_->dt == dt && tangent_->keys == keys &&
+      tangent_->last_rate <= 1.5 * tangent_->fresh_rate + 1.0)
+    return true;
+  if (!factor_tangent(dt)) return false;
+  Tangent& T = *tangent_;
+  T.keys = std::move(keys);
+  T.dt = dt;
+  T.valid = true;
+  T.fresh_rate = -1;
+  return true;
+}
+
+/// The Jacobian's estimate on the unknowns, factored: A = M + theta dt^2 K_t (velocity
+/// formulation; LDL^T), or I + theta dt^2 K_t W with W = M^-1 M_c M^-1 (momentum formulation,
+/// whose strain comes from the remapped velocities of eq. 3.2.7: M_c = sum_p m_p N_ip N_jp the
+/// consistent mass; LU). K_t is assembled from the particles
+/// at the step's start, K_t = sum_p V_p B_p^T C_p B_p (in axisymmetry B has the hoop row
+/// N_i / r_p), with C_p the elastic moduli, less the plastic part for a particle on its yield
+/// surface: C_ep = C - 6 G^2 / (3 G + H) n n^T, n = s / |s| and H the hardening slope of its
+/// flow stress (the continuum elastic-plastic tangent of J2 flow); a failed particle keeps only
+/// its bulk modulus. It is the Jacobian of the internal force of a small-strain material in
+/// the state at t^k: exact for a small step of a linear elastic material, an estimate for the
+/// rest (the state moves during the step; geometric terms are left out). Returns false when
+/// the matrix cannot be factored (the caller falls back to the diagonal).
+template <class GridT>
+bool ImplicitSolver<GridT>::factor_tangent(double dt) {
+  ScopedTimer timer(timers_, timers_.id("preconditioner"));
+  if (!tangent_) tangent_ = std::make_unique<Tangent>();
+  Tangent& T = *tangent_;
+  const std::size_t nodes = grid_.nodes(), nd = dof_node_.size();
+  const bool momentum = spec_.formulation == Formulation::Momentum;
+  T.dof_of.assign(nodes * D, -1);
+  T.entries.clear();
+  std::vector<Eigen::Triplet<double>> remap;  // momentum: W = M^-1 M_c M^-1 on the unknowns
+  for (std::size_t d = 0; d < nd; ++d) {
+    T.dof_of[std::size_t(dof_node_[d]) * D + std::size_t(dof_axis_[d])] = std::int64_t(d);
+    if (!momentum) T.entries.emplace_back(int(d), int(d), grid_.m[dof_node_[d]]);
+  }
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  using B6 = Eigen::Matrix<double, 6, D>;  // strain (Voigt xx yy zz yz xz xy, shears doubled)
+  const double c = spec_.theta * dt * dt;
+  const ParticleView<D> p = view<D>(particles_);
+  const bool axi = axisymmetric_;
+  for (const Bin& bin : binning_.bins()) {
+    std::int64_t nd_c[NMAX];
+    const int nn = grid_.cell_nodes(bin.key, nd_c);
+    for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
+      if (rigid(i)) continue;
+      const Material& mat = materials_[p.material[i]];
+      const bool failed = p.failed && p.failed[i];
+      const double G = failed ? 0.0 : mat.shear_modulus(), K = mat.spec().bulk_modulus();
+      const double lambda = K - 2.0 / 3.0 * G;
+      Mat6 C = Mat6::Zero();
+      C.template topLeftCorner<3, 3>().setConstant(lambda);
+      for (int a = 0; a < 3; ++a) C(a, a) += 2.0 * G, C(a + 3, a + 3) = G;
+      if (!failed && p.eps_p) {
+        const Sym s = deviator(p.sigma[i]);
+        const double s_norm = std::sqrt(ddot(s, s));
+        const double Tp = p.T ? p.T[i] : 0.0, ep = p.eps_p[i];
+        const double y = mat.strength().flow_stress(ep, 0.0, Tp);
+        if (std::isfinite(y) && s_norm > 0 && std::sqrt(1.5) * s_norm >= (1.0 - 1e-3) * y) {
+          const double de = 1e-6;
+          const double H = std::clamp((mat.strength().flow_stress(ep + de, 0.0, Tp) - y) / de, 0.0, 1e3 * G);
+          const Sym n = s / s_norm;
+          C.noalias() -= 6.0 * G * G / (3.0 * G + H) * (n * n.transpose());
+        }
+      }
+      const double V = p.m[i] / p.rho[i];
+      const double* N = &N_p_[std::size_t(i) * NMAX];
+      const Vec<D>* Gr = &G_p_[std::size_t(i) * NMAX];
+      B6 B[NMAX];
+      for (int a = 0; a < nn; ++a) {
+        B[a].setZero();
+        B[a](0, 0) = Gr[a][0];
+        B[a](1, 1) = Gr[a][1];
+        B[a](5, 0) = Gr[a][1];
+        B[a](5, 1) = Gr[a][0];
+        if constexpr (D == 3) {
+          B[a](2, 2) = Gr[a][2];
+          B[a](3, 1) = Gr[a][2];
+          B[a](3, 2) = Gr[a][1];
+          B[a](4, 0) = Gr[a][2];
+          B[a](4, 2) = Gr[a][0];
+        } else if (axi) {
+          B[a](2, 0) = N[a] / p.x[i][0];
+        }
+      }
+      if (momentum)
+        for (int a = 0; a < nn; ++a)
+          for (int b = 0; b < nn; ++b)
+            for (int r = 0; r < D; ++r) {
+              const std::int64_t row = T.dof_of[std::size_t(nd_c[a]) * D + std::size_t(r)];
+              const std::int64_t col = T.dof_of[std::size_t(nd_c[b]) * D + std::size_t(r)];
+              if (row >= 0 && col >= 0 && N[a] * N[b] != 0)
+                remap.emplace_back(int(row), int(col),
+                                   p.m[i] * N[a] * N[b] / (grid_.m[nd_c[a]] * grid_.m[nd_c[b]]));
+            }
+      for (int b = 0; b < nn; ++b) {
+        const Eigen::Matrix<double, 6, D> CB = C * B[b];
+        for (int a = 0; a < nn; ++a) {
+          const Mat<D> Kab = (c * V) * (B[a].transpose() * CB);
+          for (int r = 0; r < D; ++r) {
+            const std::int64_t row = T.dof_of[std::size_t(nd_c[a]) * D + std::size_t(r)];
+            if (row < 0) continue;
+            for (int q = 0; q < D; ++q) {
+              const std::int64_t col = T.dof_of[std::size_t(nd_c[b]) * D + std::size_t(q)];
+              if (col >= 0 && Kab(r, q) != 0) T.entries.emplace_back(int(row), int(col), Kab(r, q));
+            }
+          }
+        }
+      }
+    }
+  }
+  const auto n_unknowns = static_cast<Eigen::Index>(nd);
+  Eigen::SparseMatrix<double> A(n_unknowns, n_unknowns);
+  A.setFromTriplets(T.entries.begin(), T.entries.end());
+  if (!momentum) return T.factor(T.ldlt, A);
+  Eigen::SparseMatrix<double> W(n_unknowns, n_unknowns), I(n_unknowns, n_unknowns);
+  W.setFromTriplets(remap.begin(), remap.end());
+  I.setIdentity();
+  Eigen::SparseMatrix<double> J = I + Eigen::SparseMatrix<double>(A * W);
+  return T.factor(T.lu, J);
 }
 
 /// A node's index in the lattice (the whole domain), which survives refits of the window.

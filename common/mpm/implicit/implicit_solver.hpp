@@ -97,12 +97,15 @@ class ImplicitSolver {
   double typical_unknown_norm() const { return u_typ_; }
   /// Inverse of the diagonal preconditioner for a step dt (empty without one).
   const nk::Vector& inverse_diagonal() const { return inv_diag_; }
+  /// The Krylov solves' preconditioner for the step set up last (empty without one).
+  const nk::Preconditioner& preconditioner() const { return precond_; }
 
  private:
   static constexpr int NMAX = GridT::kMaxNodes;
   class System;
   struct Trial;
   struct Scratch;
+  struct Tangent;
 
   // Kernels, in the order a step uses them.
   void sort_particles();
@@ -110,6 +113,8 @@ class ImplicitSolver {
   void free_dofs();         // Dirichlet values and the unknowns
   bool attempt(double dt);  // Newton-Krylov for one dt; true when converged and unfolded
   nk::NonlinearSystem& system_for_current(double dt, nk::Vector& u0);  // scale, guess, diagonal
+  bool tangent_for(double dt);     // preconditioner = "tangent": the last factor, or a new one
+  bool factor_tangent(double dt);  // M + theta dt^2 K_t (or its momentum form), factored
   void to_grid(const nk::Vector& u, std::vector<Vec<D>>& w) const;     // unknowns to grid
   void remap_trial(const std::vector<Vec<D>>& P_L, Trial& t);          // momentum: v_p^L, v_i^L
   bool stress_trial(Trial& t);  // velocity gradient, constitutive update on a copy
@@ -180,6 +185,8 @@ class ImplicitSolver {
   std::int64_t global_key(std::int64_t node) const;
   void remember(const nk::Vector& u);
   nk::Vector inv_diag_;
+  std::unique_ptr<Tangent> tangent_;  ///< the factored M + theta dt^2 K_t (preconditioner)
+  nk::Preconditioner precond_;        ///< of the step being solved; empty: none
   nk::Vector u_;  ///< the converged unknowns
   std::unique_ptr<Trial> trial_, accepted_;
   std::unique_ptr<System> system_;

@@ -25,10 +25,14 @@ std::string to_string(Outcome o) {
 }
 
 // ------------------------------------------------------------------------------------------
-// Conjugate gradients (001, Algorithm 3), preconditioned by a diagonal.
+// Conjugate gradients (001, Algorithm 3), preconditioned.
+
+Preconditioner diagonal_preconditioner(const Vector& inv_diag) {
+  return [&inv_diag](const Vector& r, Vector& z) { z = inv_diag.cwiseProduct(r); };
+}
 
 LinearReport cg(const Operator& A, const Vector& b, Vector& x, double rtol, int max_it,
-                const Vector* inv_diag) {
+                const Preconditioner* P) {
   LinearReport rep;
   const Eigen::Index n = b.size();
   x.setZero(n);
@@ -39,7 +43,8 @@ LinearReport cg(const Operator& A, const Vector& b, Vector& x, double rtol, int 
     return rep;
   }
   Vector r = b;  // r_0 = b - A 0
-  Vector z = inv_diag ? Vector(inv_diag->cwiseProduct(r)) : r;
+  Vector z = r;
+  if (P) (*P)(r, z);
   Vector p = z, w(n);
   double rho = r.dot(z);
   for (int k = 0; k < max_it; ++k) {
@@ -61,8 +66,8 @@ LinearReport cg(const Operator& A, const Vector& b, Vector& x, double rtol, int 
     const double alpha = rho / pw;  // (b)
     x.noalias() += alpha * p;       // (c)
     r.noalias() -= alpha * w;       // (d)
-    if (inv_diag)
-      z = inv_diag->cwiseProduct(r);
+    if (P)
+      (*P)(r, z);
     else
       z = r;
     const double rho_new = r.dot(z);    // (e)
@@ -79,7 +84,7 @@ LinearReport cg(const Operator& A, const Vector& b, Vector& x, double rtol, int 
 // GMRES (001, Algorithm 4), right-preconditioned: A P^-1 y = b, x = P^-1 y.
 
 LinearReport gmres(const Operator& A, const Vector& b, Vector& x, double rtol, int basis,
-                   int restarts, const Vector* inv_diag) {
+                   int restarts, const Preconditioner* P) {
   LinearReport rep;
   const Eigen::Index n = b.size();
   x.setZero(n);
@@ -95,7 +100,10 @@ LinearReport gmres(const Operator& A, const Vector& b, Vector& x, double rtol, i
   Eigen::VectorXd cs(m), sn(m), g(m + 1);
   Vector r = b, w(n), z(n);
   auto precondition = [&](const Vector& v) -> Vector {
-    return inv_diag ? Vector(inv_diag->cwiseProduct(v)) : v;
+    if (!P) return v;
+    Vector pv(v.size());
+    (*P)(v, pv);
+    return pv;
   };
   for (int cycle = 0; cycle <= restarts; ++cycle) {
     if (cycle > 0) {  // r = b - A x for the restart
@@ -188,7 +196,7 @@ bool directional_difference(NonlinearSystem& system, const Vector& u, const Vect
   return false;
 }
 
-Report solve(NonlinearSystem& system, Vector& u, const Settings& S, const Vector* inv_diag,
+Report solve(NonlinearSystem& system, Vector& u, const Settings& S, const Preconditioner* P,
              double u_typ) {
   Report rep;
   Vector F(u.size()), F_trial(u.size()), s(u.size()), u_trial(u.size());
@@ -229,8 +237,8 @@ Report solve(NonlinearSystem& system, Vector& u, const Settings& S, const Vector
     ++rep.work.newton;
     const Vector b = -F;
     const LinearReport lin = S.krylov == KrylovMethod::CG
-                                 ? cg(J, b, s, eta, S.max_krylov, inv_diag)
-                                 : gmres(J, b, s, eta, S.gmres_basis, S.gmres_restarts, inv_diag);
+                                 ? cg(J, b, s, eta, S.max_krylov, P)
+                                 : gmres(J, b, s, eta, S.gmres_basis, S.gmres_restarts, P);
     rep.work.krylov += lin.iterations;
     if (!(s.squaredNorm() > 0) || !s.allFinite()) {
       rep.outcome = Outcome::ZeroStep;

@@ -3,7 +3,7 @@
 /// whose linear systems J s = -F are solved by conjugate gradients (Algorithm 3) or GMRES
 /// (Algorithm 4), with the Jacobian applied as the directional difference of eq. 2.4.18, a
 /// backtracking line search (section 3.2.3), fixed or Eisenstat-Walker forcing terms and an
-/// optional diagonal preconditioner. Nothing here knows about MPM: a NonlinearSystem supplies
+/// optional preconditioner. Nothing here knows about MPM: a NonlinearSystem supplies
 /// F(u), and the small dense parts (the GMRES Hessenberg least squares) use Eigen.
 #include <Eigen/Core>
 #include <functional>
@@ -32,6 +32,12 @@ class NonlinearSystem {
 /// A linear operator y = A x; returns false when it cannot be applied at x.
 using Operator = std::function<bool(const Vector& x, Vector& y)>;
 
+/// z = P^-1 r, an approximate inverse of the Jacobian: applied on the right in GMRES; for CG
+/// it must be symmetric positive definite.
+using Preconditioner = std::function<void(const Vector& r, Vector& z)>;
+/// The preconditioner of a diagonal, given as its inverse (kept by reference).
+Preconditioner diagonal_preconditioner(const Vector& inv_diag);
+
 /// How a Krylov solve ended.
 struct LinearReport {
   int iterations = 0;              ///< operator applications
@@ -40,18 +46,18 @@ struct LinearReport {
   bool failed = false;  ///< the operator could not be applied, or CG broke down
 };
 
-/// Preconditioned conjugate gradients for A x = b from x = 0 (001, Algorithm 3). `inv_diag`
-/// (may be null) is the inverse of a positive diagonal preconditioner. Stops when
+/// Preconditioned conjugate gradients for A x = b from x = 0 (001, Algorithm 3). `P` (may be
+/// null) is the preconditioner. Stops when
 /// ||r|| <= rtol ||b||, after max_it iterations, or on a non-positive curvature p.Ap (the
 /// iterate so far is kept).
 LinearReport cg(const Operator& A, const Vector& b, Vector& x, double rtol, int max_it,
-                const Vector* inv_diag);
+                const Preconditioner* P);
 
 /// GMRES for A x = b from x = 0 (001, Algorithm 4: Arnoldi with modified Gram-Schmidt, Givens
-/// rotations), right-preconditioned by the diagonal `inv_diag` (may be null), a basis of
+/// rotations), right-preconditioned by `P` (may be null), a basis of
 /// `basis` vectors, restarted `restarts` times at most.
 LinearReport gmres(const Operator& A, const Vector& b, Vector& x, double rtol, int basis,
-                   int restarts, const Vector* inv_diag);
+                   int restarts, const Preconditioner* P);
 
 /// Newton-Krylov settings, taken from the scene's ImplicitSpec.
 struct Settings {
@@ -110,9 +116,9 @@ bool directional_difference(NonlinearSystem& system, const Vector& u, const Vect
                             const Vector& s, double h, double u_typ, Vector& Js, long& evaluations);
 
 /// Solves F(u) = 0 from the initial guess u (overwritten by the last accepted iterate).
-/// `inv_diag` (may be null) is the inverse diagonal preconditioner; u_typ the typical size of
-/// ||u|| for the directional difference.
-Report solve(NonlinearSystem& system, Vector& u, const Settings& settings, const Vector* inv_diag,
+/// `P` (may be null) is the Krylov solves' preconditioner; u_typ the typical size of ||u|| for
+/// the directional difference.
+Report solve(NonlinearSystem& system, Vector& u, const Settings& settings, const Preconditioner* P,
              double u_typ);
 
 }  // namespace mpm::nk
