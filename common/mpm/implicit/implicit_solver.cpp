@@ -382,7 +382,7 @@ bool ImplicitSolver<GridT>::attempt(double dt) {
   last_work_.evaluations += rep.work.evaluations;
   last_work_.line_search_cuts += rep.work.line_search_cuts;
   last_residuals_ = rep.residuals;
-  if (tangent_ && spec_.preconditioner == Preconditioner::Tangent) {
+  if (tangent_in_use_) {  // how well the factor worked, for tangent_for's next decision
     Tangent& T = *tangent_;
     T.last_rate = rep.work.newton > 0 ? double(rep.work.krylov) / double(rep.work.newton) : 0.0;
     if (T.fresh_rate < 0) T.fresh_rate = T.last_rate;
@@ -463,6 +463,7 @@ nk::NonlinearSystem& ImplicitSolver<GridT>::system_for_current(double dt, nk::Ve
   // about cfl^2; single nodes of tiny mass exceed it at any step).
   inv_diag_.resize(0);
   precond_ = nullptr;
+  tangent_in_use_ = false;
   bool tangent = false;
   if (spec_.preconditioner != Preconditioner::None) {
     inv_diag_.resize(Eigen::Index(nd));
@@ -477,6 +478,7 @@ nk::NonlinearSystem& ImplicitSolver<GridT>::system_for_current(double dt, nk::Ve
       inv_diag_[d] = scale / j;
     }
     tangent = spec_.preconditioner == Preconditioner::Tangent && stiffness > mass && tangent_for(dt);
+    tangent_in_use_ = tangent;
     // Without it the diagonal, which helps CG and not GMRES (docs/scene.md): the momentum
     // formulation's J is then about the identity.
     if (!tangent && (spec_.preconditioner == Preconditioner::Diagonal || !momentum))

@@ -187,6 +187,7 @@ class ImplicitSolver {
   nk::Vector inv_diag_;
   std::unique_ptr<Tangent> tangent_;  ///< the factored M + theta dt^2 K_t (preconditioner)
   nk::Preconditioner precond_;        ///< of the step being solved; empty: none
+  bool tangent_in_use_ = false;       ///< precond_ is the tangent's factor
   nk::Vector u_;  ///< the converged unknowns
   std::unique_ptr<Trial> trial_, accepted_;
   std::unique_ptr<System> system_;
