@@ -504,13 +504,11 @@ template <class GridT>
 struct ImplicitSolver<GridT>::Tangent {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;  ///< velocity: M + theta dt^2 K_t
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;  ///< momentum: I + theta dt^2 K_t W
-  std::vector<std::int64_t> dof_of;  ///< node * D + component -> unknown, -1 if prescribed
   /// What the factor was built for: the unknowns (global node and component) and dt; and the
   /// Krylov iterations per Newton iteration of the first solve with it, and of the last.
   std::vector<std::int64_t> keys;
   double dt = 0, fresh_rate = -1, last_rate = 0;
   bool valid = false;
-  std::vector<Eigen::Triplet<double>> entries;
   /// The sparsity pattern the factor was analysed for: the ordering is reused while the
   /// pattern stays (the same unknowns, the particles in the same cells), only refactored.
   std::vector<int> outer, inner;
@@ -575,12 +573,12 @@ bool ImplicitSolver<GridT>::factor_tangent(double dt) {
   Tangent& T = *tangent_;
   const std::size_t nodes = grid_.nodes(), nd = dof_node_.size();
   const bool momentum = spec_.formulation == Formulation::Momentum;
-  T.dof_of.assign(nodes * D, -1);
-  T.entries.clear();
+  std::vector<std::int64_t> dof_of(nodes * D, -1);  // node * D + component -> unknown
+  std::vector<Eigen::Triplet<double>> entries;      // M (velocity) + theta dt^2 K_t
   std::vector<Eigen::Triplet<double>> remap;  // momentum: W = M^-1 M_c M^-1 on the unknowns
   for (std::size_t d = 0; d < nd; ++d) {
-    T.dof_of[std::size_t(dof_node_[d]) * D + std::size_t(dof_axis_[d])] = std::int64_t(d);
-    if (!momentum) T.entries.emplace_back(int(d), int(d), grid_.m[dof_node_[d]]);
+    dof_of[std::size_t(dof_node_[d]) * D + std::size_t(dof_axis_[d])] = std::int64_t(d);
+    if (!momentum) entries.emplace_back(int(d), int(d), grid_.m[dof_node_[d]]);
   }
   using Mat6 = Eigen::Matrix<double, 6, 6>;
   using B6 = Eigen::Matrix<double, 6, D>;  // strain (Voigt xx yy zz yz xz xy, shears doubled)
@@ -635,8 +633,8 @@ bool ImplicitSolver<GridT>::factor_tangent(double dt) {
         for (int a = 0; a < nn; ++a)
           for (int b = 0; b < nn; ++b)
             for (int r = 0; r < D; ++r) {
-              const std::int64_t row = T.dof_of[std::size_t(nd_c[a]) * D + std::size_t(r)];
-              const std::int64_t col = T.dof_of[std::size_t(nd_c[b]) * D + std::size_t(r)];
+              const std::int64_t row = dof_of[std::size_t(nd_c[a]) * D + std::size_t(r)];
+              const std::int64_t col = dof_of[std::size_t(nd_c[b]) * D + std::size_t(r)];
               if (row >= 0 && col >= 0 && N[a] * N[b] != 0)
                 remap.emplace_back(int(row), int(col),
                                    p.m[i] * N[a] * N[b] / (grid_.m[nd_c[a]] * grid_.m[nd_c[b]]));
@@ -646,11 +644,11 @@ bool ImplicitSolver<GridT>::factor_tangent(double dt) {
         for (int a = 0; a < nn; ++a) {
           const Mat<D> Kab = (c * V) * (B[a].transpose() * CB);
           for (int r = 0; r < D; ++r) {
-            const std::int64_t row = T.dof_of[std::size_t(nd_c[a]) * D + std::size_t(r)];
+            const std::int64_t row = dof_of[std::size_t(nd_c[a]) * D + std::size_t(r)];
             if (row < 0) continue;
             for (int q = 0; q < D; ++q) {
-              const std::int64_t col = T.dof_of[std::size_t(nd_c[b]) * D + std::size_t(q)];
-              if (col >= 0 && Kab(r, q) != 0) T.entries.emplace_back(int(row), int(col), Kab(r, q));
+              const std::int64_t col = dof_of[std::size_t(nd_c[b]) * D + std::size_t(q)];
+              if (col >= 0 && Kab(r, q) != 0) entries.emplace_back(int(row), int(col), Kab(r, q));
             }
           }
         }
@@ -659,7 +657,7 @@ bool ImplicitSolver<GridT>::factor_tangent(double dt) {
   }
   const auto n_unknowns = static_cast<Eigen::Index>(nd);
   Eigen::SparseMatrix<double> A(n_unknowns, n_unknowns);
-  A.setFromTriplets(T.entries.begin(), T.entries.end());
+  A.setFromTriplets(entries.begin(), entries.end());
   if (!momentum) return T.factor(T.ldlt, A);
   Eigen::SparseMatrix<double> W(n_unknowns, n_unknowns), I(n_unknowns, n_unknowns);
   W.setFromTriplets(remap.begin(), remap.end());
