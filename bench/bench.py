@@ -27,7 +27,7 @@ MODELS = {
 STRATEGIES = ["colored", "lr-slabs", "array-expansion", "patch"]
 
 # Work per particle-step of the particle kernels (3D, MUSL), counted off the code in
-# common/mpm/explicit_solver_impl.hpp and materials/*.cpp: flops (adds, multiplies, divides,
+# common/mpm/solver/explicit/explicit_solver_impl.hpp and materials/*.cpp: flops (adds, multiplies, divides,
 # square roots each 1) and bytes moved (particle columns read and written once per kernel; grid
 # traffic of the 8 cached nodes per cell, spread over the ~8 particles of a cell). Estimates to
 # about +-30%: the compiler fuses and vectorises, caches absorb some traffic.

@@ -47,7 +47,8 @@ double fma_gflops(int threads, long iterations, int repeats) {
     {
       Vd acc[kChains];
       for (int k = 0; k < kChains; ++k)
-        for (int l = 0; l < kLanes; ++l) acc[k][l] = 1.0 + 1e-3 * (k * kLanes + l) + omp_get_thread_num();
+        for (int l = 0; l < kLanes; ++l)
+          acc[k][l] = 1.0 + 1e-3 * (k * kLanes + l) + omp_get_thread_num();
       const Vd x = Vd{} + 0.999999, y = Vd{} + 1e-7;
       for (long it = 0; it < iterations; ++it) {
 #pragma GCC unroll 16
@@ -75,8 +76,9 @@ int main(int argc, char** argv) {
     fl[t] = fma_gflops(t, 4000000, 5);
   }
   if (json) {
-    std::printf("{\"triad_GBs\": {\"1\": %.2f, \"2\": %.2f}, \"fma_GFLOPs\": {\"1\": %.2f, \"2\": %.2f}}\n",
-                bw[1], bw[2], fl[1], fl[2]);
+    std::printf(
+        "{\"triad_GBs\": {\"1\": %.2f, \"2\": %.2f}, \"fma_GFLOPs\": {\"1\": %.2f, \"2\": %.2f}}\n",
+        bw[1], bw[2], fl[1], fl[2]);
   } else {
     std::printf("%-8s %16s %16s %12s\n", "threads", "triad GB/s", "FMA GFLOP/s", "ridge flop/B");
     for (int t = 1; t <= 2; ++t)

@@ -12,21 +12,23 @@
 #include <memory>
 #include <optional>
 
-#include "mpm/cli.hpp"
-#include "mpm/error.hpp"
-#include "mpm/graded_grid.hpp"
-#include "mpm/post.hpp"
-#include "mpm/profile.hpp"
-#include "mpm/stream.hpp"
-#include "mpm/units.hpp"
-#include "mpm/version.hpp"
-#include "mpm/vtk/vtk_output.hpp"
+#include "mpm/core/cli.hpp"
+#include "mpm/core/error.hpp"
+#include "mpm/core/units.hpp"
+#include "mpm/core/version.hpp"
+#include "mpm/grid/graded_grid.hpp"
+#include "mpm/post/post.hpp"
+#include "mpm/post/profile.hpp"
+#include "mpm/post/vtk/vtk_output.hpp"
+#include "mpm/stream/stream.hpp"
 
 namespace {
 
 using namespace mpm;
 
-std::string input_name(const std::string& path) { return path == "-" ? "stdin" : path; }
+std::string input_name(const std::string& path) {
+  return path == "-" ? "stdin" : path;
+}
 
 /// What every subcommand says after reading: damage (exit 2), an unfinished or failed run.
 int conclude(const std::string& path, const StreamSummary& s, std::size_t frames_used) {
@@ -65,10 +67,14 @@ std::string json_number(double v) {
 std::string json_string(const std::string& s) {
   std::string o = "\"";
   for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\', o += c;
-    else if (c == '\n') o += "\\n";
-    else if (static_cast<unsigned char>(c) < 0x20) o += ' ';
-    else o += c;
+    if (c == '"' || c == '\\')
+      o += '\\', o += c;
+    else if (c == '\n')
+      o += "\\n";
+    else if (static_cast<unsigned char>(c) < 0x20)
+      o += ' ';
+    else
+      o += c;
   }
   return o + "\"";
 }
@@ -132,10 +138,11 @@ int cmd_summary(const std::string& path, bool json) {
     for (std::size_t k = 0; k < frames.size(); ++k)
       std::printf("%s{\"step\": %lld, \"time\": %s, \"particles\": %zu}", k ? ", " : "",
                   (long long)frames[k].step, json_number(frames[k].time).c_str(), frames[k].n);
-    std::printf("], \"history_rows\": %zu, \"ended\": %s, \"status\": %d, \"message\": %s, "
-                "\"damage\": %s}\n",
-                hist_rows, s.ended ? "true" : "false", s.end_status,
-                json_string(s.end_message).c_str(), json_string(s.damage).c_str());
+    std::printf(
+        "], \"history_rows\": %zu, \"ended\": %s, \"status\": %d, \"message\": %s, "
+        "\"damage\": %s}\n",
+        hist_rows, s.ended ? "true" : "false", s.end_status, json_string(s.end_message).c_str(),
+        json_string(s.damage).c_str());
   } else {
     std::printf("stream: %s\n", input_name(path).c_str());
     if (!title.empty()) std::printf("scene: %s (%dD)\n", title.c_str(), dim);
@@ -143,14 +150,17 @@ int cmd_summary(const std::string& path, bool json) {
     std::printf("  %8s %14s %12s\n", "step", "time (us)", "particles");
     for (const auto& f : frames)
       std::printf("  %8lld %14.4f %12zu%s\n", (long long)f.step, f.time * 1e6, f.n,
-                  (f.flags & kFrameModel) ? "  (model)" : (f.flags & kFrameFinal) ? "  (final)" : "");
+                  (f.flags & kFrameModel)   ? "  (model)"
+                  : (f.flags & kFrameFinal) ? "  (final)"
+                                            : "");
     std::printf("history: %zu rows", hist_rows);
     if (!hist_names.empty()) {
       std::printf(" of");
       for (auto& n : hist_names) std::printf(" %s", n.c_str());
     }
-    std::printf("\nend: %s\n", s.ended ? ("status " + std::to_string(s.end_status) + ", " + s.end_message).c_str()
-                                       : "missing (the producer stopped early or is still running)");
+    std::printf("\nend: %s\n",
+                s.ended ? ("status " + std::to_string(s.end_status) + ", " + s.end_message).c_str()
+                        : "missing (the producer stopped early or is still running)");
     if (!s.damage.empty()) std::printf("damage: %s\n", s.damage.c_str());
   }
   if (!s.damage.empty()) {
@@ -161,7 +171,8 @@ int cmd_summary(const std::string& path, bool json) {
 }
 
 // history ---------------------------------------------------------------------------------
-int cmd_history(const std::string& path, const std::string& out, const std::vector<std::string>& cols) {
+int cmd_history(const std::string& path, const std::string& out,
+                const std::vector<std::string>& cols) {
   std::vector<std::string> names;
   std::vector<int> pick;
   std::FILE* f = out == "-" ? stdout : std::fopen(out.c_str(), "w");
@@ -181,7 +192,8 @@ int cmd_history(const std::string& path, const std::string& out, const std::vect
           if (it == names.end()) {
             std::string known;
             for (auto& n : names) known += (known.empty() ? "" : ", ") + n;
-            throw InputError("--columns", "unknown history column '" + c + "' (known: " + known + ")");
+            throw InputError("--columns",
+                             "unknown history column '" + c + "' (known: " + known + ")");
           }
           pick.push_back(int(it - names.begin()));
         }
@@ -198,8 +210,10 @@ int cmd_history(const std::string& path, const std::string& out, const std::vect
     }
   };
   const StreamSummary s = read_stream(path, v);
-  if (f != stdout) std::fclose(f);
-  else std::fflush(stdout);
+  if (f != stdout)
+    std::fclose(f);
+  else
+    std::fflush(stdout);
   return conclude(path, s, frames);
 }
 
@@ -207,8 +221,9 @@ int cmd_history(const std::string& path, const std::string& out, const std::vect
 int cmd_vtk(const std::string& path, const std::string& dir, const std::string& name, int every) {
   std::error_code ec;
   if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
-    throw InputError("-o " + dir, "exists and is not a directory (vtk writes a directory of .vtu "
-                                  "files and a .pvd series)");
+    throw InputError("-o " + dir,
+                     "exists and is not a directory (vtk writes a directory of .vtu "
+                     "files and a .pvd series)");
   std::filesystem::create_directories(dir, ec);
   if (ec) throw IoError("cannot create the directory '" + dir + "': " + ec.message());
   std::vector<std::pair<double, std::string>> entries;
@@ -243,7 +258,8 @@ int cmd_vtk(const std::string& path, const std::string& dir, const std::string& 
                (std::filesystem::path(dir) / (name + ".pvd")).string().c_str());
   if (!grids.empty())
     std::fprintf(stderr, "mpm-post: wrote %zu graded grid(s) and %s (cell field 'level')\n",
-                 grids.size(), (std::filesystem::path(dir) / (name + "_grid.pvd")).string().c_str());
+                 grids.size(),
+                 (std::filesystem::path(dir) / (name + "_grid.pvd")).string().c_str());
   return conclude(path, s, index);
 }
 
@@ -288,19 +304,25 @@ int cmd_taylor(const std::string& path, const TaylorArgs& a) {
   if (!a.expect_L.empty()) eL = quantity(a.expect_L, dim::length, "--expect-L");
   if (!a.expect_D.empty()) eD = quantity(a.expect_D, dim::length, "--expect-D");
   if (a.json) {
-    std::printf("{\"time\": %s, \"measure\": %s, \"L\": %s, \"D\": %s, \"L0\": %s, \"D0\": %s, "
-                "\"axis\": \"%c\", \"wall\": %s, \"spacing\": %s, \"particles\": %zu",
-                json_number(r.time).c_str(), json_string(r.measure).c_str(), json_number(r.L).c_str(),
-                json_number(r.D).c_str(), json_number(r.L0).c_str(), json_number(r.D0).c_str(),
-                "xyz"[r.axis], json_number(r.wall).c_str(), json_number(r.spacing).c_str(), r.particles);
+    std::printf(
+        "{\"time\": %s, \"measure\": %s, \"L\": %s, \"D\": %s, \"L0\": %s, \"D0\": %s, "
+        "\"axis\": \"%c\", \"wall\": %s, \"spacing\": %s, \"particles\": %zu",
+        json_number(r.time).c_str(), json_string(r.measure).c_str(), json_number(r.L).c_str(),
+        json_number(r.D).c_str(), json_number(r.L0).c_str(), json_number(r.D0).c_str(),
+        "xyz"[r.axis], json_number(r.wall).c_str(), json_number(r.spacing).c_str(), r.particles);
     std::printf(", \"D_min\": %s, \"D_max\": %s, \"D_radius\": %s", json_number(r.D_min).c_str(),
                 json_number(r.D_max).c_str(), json_number(r.D_radius).c_str());
-    if (eL) std::printf(", \"expected_L\": %s, \"error_L\": %s", json_number(*eL).c_str(), json_number(r.L / *eL - 1).c_str());
-    if (eD) std::printf(", \"expected_D\": %s, \"error_D\": %s", json_number(*eD).c_str(), json_number(r.D / *eD - 1).c_str());
+    if (eL)
+      std::printf(", \"expected_L\": %s, \"error_L\": %s", json_number(*eL).c_str(),
+                  json_number(r.L / *eL - 1).c_str());
+    if (eD)
+      std::printf(", \"expected_D\": %s, \"error_D\": %s", json_number(*eD).c_str(),
+                  json_number(r.D / *eD - 1).c_str());
     std::printf("}\n");
   } else {
     std::printf("Taylor bar at t = %.4g us (%s; axis %c, wall at %.4g mm, %zu particles)\n",
-                r.time * 1e6, r.measure == "centres" ? "particle centres" : "surface: centres + half a spacing",
+                r.time * 1e6,
+                r.measure == "centres" ? "particle centres" : "surface: centres + half a spacing",
                 "xyz"[r.axis], r.wall * 1e3, r.particles);
     std::printf("  L = %.3f mm", r.L * 1e3);
     if (eL) std::printf("   expected %.3f mm, %+.2f%%", *eL * 1e3, 100 * (r.L / *eL - 1));
@@ -309,8 +331,10 @@ int cmd_taylor(const std::string& path, const TaylorArgs& a) {
     if (eD) std::printf("   expected %.3f mm, %+.2f%%", *eD * 1e3, 100 * (r.D / *eD - 1));
     std::printf("   (D0 = %.3f mm, D/D0 = %.4f)\n", r.D0 * 1e3, r.D / r.D0);
     if (r.D_max > r.D_min)
-      std::printf("      mean caliper width; %.3f to %.3f mm by direction, twice the largest "
-                  "radius %.3f mm\n", r.D_min * 1e3, r.D_max * 1e3, r.D_radius * 1e3);
+      std::printf(
+          "      mean caliper width; %.3f to %.3f mm by direction, twice the largest "
+          "radius %.3f mm\n",
+          r.D_min * 1e3, r.D_max * 1e3, r.D_radius * 1e3);
   }
   std::fflush(stdout);
   return conclude(path, s, frames);
@@ -354,7 +378,8 @@ int cmd_debris(const std::string& path, const DebrisArgs& a) {
   };
   const StreamSummary s = read_stream(path, v);
   if (!chosen) {
-    std::fprintf(stderr, "mpm-post: error: %s holds no frame to measure\n", input_name(path).c_str());
+    std::fprintf(stderr, "mpm-post: error: %s holds no frame to measure\n",
+                 input_name(path).c_str());
     return kExitBadInput;
   }
   const DebrisResult& r = *chosen;
@@ -362,42 +387,57 @@ int cmd_debris(const std::string& path, const DebrisArgs& a) {
   if (!a.expect_front.empty()) ef = quantity(a.expect_front, dim::length, "--expect-front");
   if (!a.expect_width.empty()) ew = quantity(a.expect_width, dim::length, "--expect-width");
   if (a.json) {
-    std::printf("{\"time\": %s, \"axis\": \"%c\", \"direction\": %d, \"plane\": %s, \"cloud_particles\": %zu, "
-                "\"particles\": %zu, \"percentile\": %s, \"front\": %s, \"width\": %s, "
-                "\"front_max\": %s, \"front_p99\": %s, \"front_p99_5\": %s, \"front_p99_9\": %s, "
-                "\"width_max\": %s, \"width_p99\": %s, \"width_p99_5\": %s, \"width_p99_9\": %s",
-                json_number(r.time).c_str(), "xyz"[r.axis], r.direction, json_number(r.plane).c_str(),
-                r.cloud, r.total, json_number(r.percentile).c_str(), json_number(r.front).c_str(),
-                json_number(r.width).c_str(), json_number(r.front_max).c_str(), json_number(r.front_p99).c_str(),
-                json_number(r.front_p995).c_str(), json_number(r.front_p999).c_str(),
-                json_number(r.width_max).c_str(), json_number(r.width_p99).c_str(),
-                json_number(r.width_p995).c_str(), json_number(r.width_p999).c_str());
-    std::printf(", \"link\": %s, \"min_fragment\": %zu, \"fragments\": %zu, \"single_particle_fragments\": %zu, "
-                "\"largest_fragment\": %zu, \"counted_particles\": %zu, \"percentiles_of\": \"%s\"",
-                json_number(r.link).c_str(), r.min_fragment, r.fragments, r.singles, r.largest, r.counted,
-                r.by_mass ? "mass" : "particles");
-    if (ef) std::printf(", \"expected_front\": %s, \"error_front\": %s", json_number(*ef).c_str(), json_number(r.front / *ef - 1).c_str());
-    if (ew) std::printf(", \"expected_width\": %s, \"error_width\": %s", json_number(*ew).c_str(), json_number(r.width / *ew - 1).c_str());
+    std::printf(
+        "{\"time\": %s, \"axis\": \"%c\", \"direction\": %d, \"plane\": %s, \"cloud_particles\": "
+        "%zu, "
+        "\"particles\": %zu, \"percentile\": %s, \"front\": %s, \"width\": %s, "
+        "\"front_max\": %s, \"front_p99\": %s, \"front_p99_5\": %s, \"front_p99_9\": %s, "
+        "\"width_max\": %s, \"width_p99\": %s, \"width_p99_5\": %s, \"width_p99_9\": %s",
+        json_number(r.time).c_str(), "xyz"[r.axis], r.direction, json_number(r.plane).c_str(),
+        r.cloud, r.total, json_number(r.percentile).c_str(), json_number(r.front).c_str(),
+        json_number(r.width).c_str(), json_number(r.front_max).c_str(),
+        json_number(r.front_p99).c_str(), json_number(r.front_p995).c_str(),
+        json_number(r.front_p999).c_str(), json_number(r.width_max).c_str(),
+        json_number(r.width_p99).c_str(), json_number(r.width_p995).c_str(),
+        json_number(r.width_p999).c_str());
+    std::printf(
+        ", \"link\": %s, \"min_fragment\": %zu, \"fragments\": %zu, \"single_particle_fragments\": "
+        "%zu, "
+        "\"largest_fragment\": %zu, \"counted_particles\": %zu, \"percentiles_of\": \"%s\"",
+        json_number(r.link).c_str(), r.min_fragment, r.fragments, r.singles, r.largest, r.counted,
+        r.by_mass ? "mass" : "particles");
+    if (ef)
+      std::printf(", \"expected_front\": %s, \"error_front\": %s", json_number(*ef).c_str(),
+                  json_number(r.front / *ef - 1).c_str());
+    if (ew)
+      std::printf(", \"expected_width\": %s, \"error_width\": %s", json_number(*ew).c_str(),
+                  json_number(r.width / *ew - 1).c_str());
     std::printf("}\n");
   } else {
-    std::printf("Debris cloud at t = %.4g us: %zu of %zu particles behind the plane %c = %.3f mm "
-                "(the target's rear face), impact along %s%c\n",
-                r.time * 1e6, r.cloud, r.total, "xyz"[r.axis], r.plane * 1e3, r.direction > 0 ? "+" : "-",
-                "xyz"[r.axis]);
-    std::printf("  fragments (particles closer than %.3g mm linked): %zu, %zu of them single particles, the "
-                "largest %zu particles\n", r.link * 1e3, r.fragments, r.singles, r.largest);
+    std::printf(
+        "Debris cloud at t = %.4g us: %zu of %zu particles behind the plane %c = %.3f mm "
+        "(the target's rear face), impact along %s%c\n",
+        r.time * 1e6, r.cloud, r.total, "xyz"[r.axis], r.plane * 1e3, r.direction > 0 ? "+" : "-",
+        "xyz"[r.axis]);
+    std::printf(
+        "  fragments (particles closer than %.3g mm linked): %zu, %zu of them single particles, "
+        "the "
+        "largest %zu particles\n",
+        r.link * 1e3, r.fragments, r.singles, r.largest);
     if (r.min_fragment > 1)
-      std::printf("  counted: the %zu particles of fragments of at least %zu particles\n", r.counted, r.min_fragment);
+      std::printf("  counted: the %zu particles of fragments of at least %zu particles\n",
+                  r.counted, r.min_fragment);
     std::printf("  %-8s %10s %10s %10s %10s\n", "mm", "max", "p99", "p99.5", "p99.9");
-    std::printf("  %-8s %10.1f %10.1f %10.1f %10.1f\n", "front", r.front_max * 1e3, r.front_p99 * 1e3,
-                r.front_p995 * 1e3, r.front_p999 * 1e3);
-    std::printf("  %-8s %10.1f %10.1f %10.1f %10.1f\n", "width", r.width_max * 1e3, r.width_p99 * 1e3,
-                r.width_p995 * 1e3, r.width_p999 * 1e3);
+    std::printf("  %-8s %10.1f %10.1f %10.1f %10.1f\n", "front", r.front_max * 1e3,
+                r.front_p99 * 1e3, r.front_p995 * 1e3, r.front_p999 * 1e3);
+    std::printf("  %-8s %10.1f %10.1f %10.1f %10.1f\n", "width", r.width_max * 1e3,
+                r.width_p99 * 1e3, r.width_p995 * 1e3, r.width_p999 * 1e3);
     std::printf("  front = %.1f mm", r.front * 1e3);
     if (ef) std::printf(" (expected %.1f mm, %+.1f%%)", *ef * 1e3, 100 * (r.front / *ef - 1));
     std::printf(", width = %.1f mm", r.width * 1e3);
     if (ew) std::printf(" (expected %.1f mm, %+.1f%%)", *ew * 1e3, 100 * (r.width / *ew - 1));
-    std::printf("   [%g-th percentile of the cloud's %s]\n", r.percentile, r.by_mass ? "mass" : "particles");
+    std::printf("   [%g-th percentile of the cloud's %s]\n", r.percentile,
+                r.by_mass ? "mass" : "particles");
   }
   std::fflush(stdout);
   return conclude(path, s, frames);
@@ -525,7 +565,8 @@ int cmd_profile(const std::string& path, ProfileArgs& a) {
   if (a.along != "x" && a.along != "y" && a.along != "z")
     throw InputError("--along", "expected x, y or z, got '" + a.along + "'");
   o.axis = a.along[0] - 'x';
-  if (a.from.empty() != a.to.empty()) throw InputError(a.from.empty() ? "--from" : "--to", "give both --from and --to");
+  if (a.from.empty() != a.to.empty())
+    throw InputError(a.from.empty() ? "--from" : "--to", "give both --from and --to");
   if (!a.from.empty()) o.from = point(a.from, "--from"), o.to = point(a.to, "--to");
   if (!a.radius.empty()) o.radius = quantity(a.radius, dim::length, "--radius");
   std::vector<double> want_t;
@@ -549,9 +590,12 @@ int cmd_profile(const std::string& path, ProfileArgs& a) {
       }
       if (a.grid) {
         if (!sc.grid.levels.empty())
-          throw InputError("--grid", "the run's grid is graded (grid.levels): profiles on the grid need a uniform one");
+          throw InputError(
+              "--grid",
+              "the run's grid is graded (grid.levels): profiles on the grid need a uniform one");
         if (!sc.grid.domain_given)
-          throw InputError("--grid", "the stream's scene has no grid.domain (written by an older mpm-prep?)");
+          throw InputError("--grid",
+                           "the stream's scene has no grid.domain (written by an older mpm-prep?)");
         o.on_grid = true;
         o.cell = sc.grid.cell_size;
         o.origin = sc.grid.domain_min;
@@ -559,7 +603,8 @@ int cmd_profile(const std::string& path, ProfileArgs& a) {
     }
   };
   v.frame = [&](Frame&& f) {
-    if (a.grid && !o.on_grid) throw InputError("--grid", "the stream holds no scene before its frames");
+    if (a.grid && !o.on_grid)
+      throw InputError("--grid", "the stream holds no scene before its frames");
     const long k = index++;
     const int dim = f.columns.at("x").info().components;
     std::shared_ptr<Profile> p;
@@ -568,7 +613,8 @@ int cmd_profile(const std::string& path, ProfileArgs& a) {
       return p;
     };
     for (std::size_t r = 0; r < want_t.size(); ++r)
-      if (std::abs(f.time - want_t[r]) < best[r]) best[r] = std::abs(f.time - want_t[r]), by_time[r] = get();
+      if (std::abs(f.time - want_t[r]) < best[r])
+        best[r] = std::abs(f.time - want_t[r]), by_time[r] = get();
     for (std::size_t r = 0; r < a.frames.size(); ++r)
       if (a.frames[r] == k) by_index[r] = get();
     if (want_t.empty() && a.frames.empty()) last = get();
@@ -579,15 +625,16 @@ int cmd_profile(const std::string& path, ProfileArgs& a) {
     if (p) profiles.push_back(*p);
   for (std::size_t r = 0; r < by_index.size(); ++r) {
     if (!by_index[r]) {
-      std::fprintf(stderr, "mpm-post: error: %s has no frame %ld (it holds %ld)\n", input_name(path).c_str(),
-                   a.frames[r], index);
+      std::fprintf(stderr, "mpm-post: error: %s has no frame %ld (it holds %ld)\n",
+                   input_name(path).c_str(), a.frames[r], index);
       return kExitBadInput;
     }
     profiles.push_back(*by_index[r]);
   }
   if (last) profiles.push_back(*last);
   if (profiles.empty()) {
-    std::fprintf(stderr, "mpm-post: error: %s holds no frame to profile\n", input_name(path).c_str());
+    std::fprintf(stderr, "mpm-post: error: %s holds no frame to profile\n",
+                 input_name(path).c_str());
     return kExitBadInput;
   }
   std::FILE* out = a.output == "-" ? stdout : std::fopen(a.output.c_str(), "w");
@@ -595,15 +642,19 @@ int cmd_profile(const std::string& path, ProfileArgs& a) {
   const bool bins = o.bins > 0;
   if (a.json) {
     const Profile& p0 = profiles.front();
-    std::fprintf(out, "{\"field\": %s, \"component\": %d, \"unit\": %s, \"from\": [%s, %s, %s], \"to\": [%s, %s, %s], \"profiles\": [",
+    std::fprintf(out,
+                 "{\"field\": %s, \"component\": %d, \"unit\": %s, \"from\": [%s, %s, %s], \"to\": "
+                 "[%s, %s, %s], \"profiles\": [",
                  json_string(o.field).c_str(), o.component, json_string(p0.unit).c_str(),
-                 json_number(p0.from[0]).c_str(), json_number(p0.from[1]).c_str(), json_number(p0.from[2]).c_str(),
-                 json_number(p0.to[0]).c_str(), json_number(p0.to[1]).c_str(), json_number(p0.to[2]).c_str());
+                 json_number(p0.from[0]).c_str(), json_number(p0.from[1]).c_str(),
+                 json_number(p0.from[2]).c_str(), json_number(p0.to[0]).c_str(),
+                 json_number(p0.to[1]).c_str(), json_number(p0.to[2]).c_str());
     for (std::size_t k = 0; k < profiles.size(); ++k) {
       const Profile& p = profiles[k];
       auto array = [&](const char* name, const std::vector<double>& x) {
         std::fprintf(out, ", \"%s\": [", name);
-        for (std::size_t i = 0; i < x.size(); ++i) std::fprintf(out, "%s%s", i ? ", " : "", json_number(x[i]).c_str());
+        for (std::size_t i = 0; i < x.size(); ++i)
+          std::fprintf(out, "%s%s", i ? ", " : "", json_number(x[i]).c_str());
         std::fprintf(out, "]");
       };
       std::fprintf(out, "%s{\"time\": %s", k ? ", " : "", json_number(p.time).c_str());
@@ -624,14 +675,15 @@ int cmd_profile(const std::string& path, ProfileArgs& a) {
     for (const Profile& p : profiles)
       for (std::size_t i = 0; i < p.s.size(); ++i) {
         if (bins)
-          std::fprintf(out, "%.10g,%.10g,%.10g,%.10g,%.10g,%zu,%.10g\n", p.time, p.s[i], p.value[i], p.min[i],
-                       p.max[i], p.count[i], p.weight[i]);
+          std::fprintf(out, "%.10g,%.10g,%.10g,%.10g,%.10g,%zu,%.10g\n", p.time, p.s[i], p.value[i],
+                       p.min[i], p.max[i], p.count[i], p.weight[i]);
         else
           std::fprintf(out, "%.10g,%.10g,%.10g,%.10g\n", p.time, p.s[i], p.value[i], p.weight[i]);
       }
   }
   if (out != stdout) {
-    if (std::fclose(out) != 0) throw IoError("cannot write '" + a.output + "': " + std::strerror(errno));
+    if (std::fclose(out) != 0)
+      throw IoError("cannot write '" + a.output + "': " + std::strerror(errno));
   } else {
     std::fflush(stdout);
   }
@@ -647,7 +699,8 @@ struct RenderArgs {
 
 int cmd_render(const std::string& path, RenderArgs& a) {
   RenderOptions& o = a.opt;
-  if (std::sscanf(a.size.c_str(), "%dx%d", &o.width, &o.height) != 2 || o.width < 16 || o.height < 16)
+  if (std::sscanf(a.size.c_str(), "%dx%d", &o.width, &o.height) != 2 || o.width < 16 ||
+      o.height < 16)
     throw InputError("--size", "expected WIDTHxHEIGHT in pixels, got '" + a.size + "'");
   if (!a.range.empty() && std::sscanf(a.range.c_str(), "%lf:%lf", &o.range_min, &o.range_max) == 2)
     o.range_given = true;
@@ -657,7 +710,8 @@ int cmd_render(const std::string& path, RenderArgs& a) {
   if (a.frame != "last") {
     char* end = nullptr;
     want = std::strtol(a.frame.c_str(), &end, 10);
-    if (!end || *end || want < 0) throw InputError("--frame", "expected a frame index or 'last', got '" + a.frame + "'");
+    if (!end || *end || want < 0)
+      throw InputError("--frame", "expected a frame index or 'last', got '" + a.frame + "'");
   }
   std::optional<double> at;
   if (!a.time.empty()) at = quantity(a.time, dim::time, "--time");
@@ -678,8 +732,8 @@ int cmd_render(const std::string& path, RenderArgs& a) {
   };
   const StreamSummary s = read_stream(path, v);
   if (!chosen) {
-    std::fprintf(stderr, "mpm-post: error: %s has no frame %s (it holds %ld)\n", input_name(path).c_str(),
-                 a.frame.c_str(), index);
+    std::fprintf(stderr, "mpm-post: error: %s has no frame %s (it holds %ld)\n",
+                 input_name(path).c_str(), a.frame.c_str(), index);
     return kExitBadInput;
   }
   const int dim = chosen->columns.at("x").info().components;
@@ -697,11 +751,12 @@ int cmd_render(const std::string& path, RenderArgs& a) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"mpm-post: read a result stream (from mpm-run) and report.\n"
-               "INPUT is a stream file or - for stdin. --json on measurements prints JSON.\n"
-               "Exit status: 0 done, 2 bad input or damaged stream (the frames before the\n"
-               "damage are still used), 3 the run was unstable, 4 write failure.",
-               "mpm-post"};
+  CLI::App app{
+      "mpm-post: read a result stream (from mpm-run) and report.\n"
+      "INPUT is a stream file or - for stdin. --json on measurements prints JSON.\n"
+      "Exit status: 0 done, 2 bad input or damaged stream (the frames before the\n"
+      "damage are still used), 3 the run was unstable, 4 write failure.",
+      "mpm-post"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("mpm-post ") + mpm::kVersion);
   std::string input = "-";
@@ -711,7 +766,8 @@ int main(int argc, char** argv) {
   summary->add_option("input", input, "stream, - for stdin")->capture_default_str();
   summary->add_flag("--json", summary_json, "print JSON");
 
-  auto* history = app.add_subcommand("history", "time histories as CSV (energies, momentum, wall forces)");
+  auto* history =
+      app.add_subcommand("history", "time histories as CSV (energies, momentum, wall forces)");
   std::string hist_out = "-";
   std::vector<std::string> hist_cols;
   history->add_option("input", input, "stream, - for stdin")->capture_default_str();
@@ -736,76 +792,122 @@ int main(int argc, char** argv) {
   vtk->add_option("-o,--output", vtk_dir, "directory")->capture_default_str();
   vtk->add_option("--name", vtk_name, "file name prefix")->capture_default_str();
   vtk->add_option("--every", vtk_every, "write every Nth frame (the final one always)")
-      ->check(CLI::PositiveNumber)->capture_default_str();
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
 
-  auto* taylor = app.add_subcommand("taylor", "final length L and foot diameter D (mean caliper width) of a bar against a wall");
+  auto* taylor = app.add_subcommand(
+      "taylor", "final length L and foot diameter D (mean caliper width) of a bar against a wall");
   TaylorArgs ta;
   taylor->add_option("input", input, "stream, - for stdin")->capture_default_str();
   taylor->add_option("--body", ta.body, "body name (default: the first)");
   taylor->add_option("--axis", ta.axis, "bar axis x, y or z (default: its longest extent)");
-  taylor->add_option("--wall", ta.wall, "wall position along the axis, e.g. \"0 mm\" (default: the constrained domain face)");
-  taylor->add_flag("--surface", ta.surface, "measure the surface (centres + half a particle spacing) instead of particle centres");
-  taylor->add_option("--expect-L", ta.expect_L, "reference length, e.g. \"16.2 mm\", to print the difference");
+  taylor->add_option(
+      "--wall", ta.wall,
+      "wall position along the axis, e.g. \"0 mm\" (default: the constrained domain face)");
+  taylor->add_flag(
+      "--surface", ta.surface,
+      "measure the surface (centres + half a particle spacing) instead of particle centres");
+  taylor->add_option("--expect-L", ta.expect_L,
+                     "reference length, e.g. \"16.2 mm\", to print the difference");
   taylor->add_option("--expect-D", ta.expect_D, "reference diameter, e.g. \"13.5 mm\"");
   taylor->add_flag("--json", ta.json, "print JSON (SI units)");
 
-  auto* debris = app.add_subcommand("debris", "front and width of a debris cloud behind a struck plate");
+  auto* debris =
+      app.add_subcommand("debris", "front and width of a debris cloud behind a struck plate");
   DebrisArgs da;
   debris->add_option("input", input, "stream, - for stdin")->capture_default_str();
-  debris->add_option("--time", da.time, "the frame nearest this time, e.g. \"30.6 us\" (default: the last)");
-  debris->add_option("--axis", da.axis, "impact axis x, y or z (default: the projectile's velocity)");
-  debris->add_option("--plane", da.plane, "reference plane along the axis, e.g. \"6.36 mm\" (default: the target's rear face)");
+  debris->add_option("--time", da.time,
+                     "the frame nearest this time, e.g. \"30.6 us\" (default: the last)");
+  debris->add_option("--axis", da.axis,
+                     "impact axis x, y or z (default: the projectile's velocity)");
+  debris->add_option(
+      "--plane", da.plane,
+      "reference plane along the axis, e.g. \"6.36 mm\" (default: the target's rear face)");
   debris->add_option("--target", da.target, "target body (default: the first body at rest)");
   debris->add_option("--projectile", da.projectile, "projectile body (default: the fastest body)");
-  debris->add_option("--percentile", da.percentile,
-                     "which particles count: the front and width reported are this percentile of the "
-                     "cloud's distances, by mass (stray particles beyond it are ignored; max and 99/99.5/99.9 "
-                     "are always printed; axisymmetric: the axis is y, each ring weighs its mass)")
-      ->check(CLI::Range(0.0, 100.0))->capture_default_str();
-  debris->add_option("--min-fragment", da.min_fragment,
-                     "which particles count: only those of fragments of at least this many particles "
-                     "(particles closer than --link are one fragment); 1: all")
-      ->check(CLI::PositiveNumber)->capture_default_str();
+  debris
+      ->add_option(
+          "--percentile", da.percentile,
+          "which particles count: the front and width reported are this percentile of the "
+          "cloud's distances, by mass (stray particles beyond it are ignored; max and 99/99.5/99.9 "
+          "are always printed; axisymmetric: the axis is y, each ring weighs its mass)")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
+  debris
+      ->add_option("--min-fragment", da.min_fragment,
+                   "which particles count: only those of fragments of at least this many particles "
+                   "(particles closer than --link are one fragment); 1: all")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   debris->add_option("--link", da.link,
                      "linking length of fragments, e.g. \"1 mm\" (default: the grid's cell size)");
   debris->add_option("--expect-front", da.expect_front, "reference front, e.g. \"200 mm\"");
   debris->add_option("--expect-width", da.expect_width, "reference width, e.g. \"145 mm\"");
   debris->add_flag("--json", da.json, "print JSON (SI units)");
-  auto* profile = app.add_subcommand("profile", "a field along a line (stress waves, shocks), CSV or JSON");
+  auto* profile =
+      app.add_subcommand("profile", "a field along a line (stress waves, shocks), CSV or JSON");
   ProfileArgs pa;
   profile->add_option("input", input, "stream, - for stdin")->capture_default_str();
-  profile->add_option("-o,--output", pa.output, "CSV (or JSON) file, - for stdout")->capture_default_str();
-  profile->add_option("--field", pa.opt.field, "a column (sigma, v, eps_p, ...) or pressure, von_mises, speed")->capture_default_str();
-  profile->add_option("--component", pa.component, "xx, yy, zz, yz, xz, xy (tensors), x, y, z (vectors), an index, or magnitude")->capture_default_str();
-  profile->add_option("--along", pa.along, "the line's direction when --from/--to are not given: x, y or z, over the particles' extent through their centroid")->capture_default_str();
+  profile->add_option("-o,--output", pa.output, "CSV (or JSON) file, - for stdout")
+      ->capture_default_str();
+  profile
+      ->add_option("--field", pa.opt.field,
+                   "a column (sigma, v, eps_p, ...) or pressure, von_mises, speed")
+      ->capture_default_str();
+  profile
+      ->add_option("--component", pa.component,
+                   "xx, yy, zz, yz, xz, xy (tensors), x, y, z (vectors), an index, or magnitude")
+      ->capture_default_str();
+  profile
+      ->add_option("--along", pa.along,
+                   "the line's direction when --from/--to are not given: x, y or z, over the "
+                   "particles' extent through their centroid")
+      ->capture_default_str();
   profile->add_option("--from", pa.from, "start of the line, e.g. \"0 0 0 mm\"");
   profile->add_option("--to", pa.to, "end of the line");
-  profile->add_option("--radius", pa.radius, "leave out particles farther than this from the line, e.g. \"1 mm\" (default: none)");
+  profile->add_option(
+      "--radius", pa.radius,
+      "leave out particles farther than this from the line, e.g. \"1 mm\" (default: none)");
   profile->add_option("--body", pa.body, "only this body's particles");
-  profile->add_option("--bins", pa.opt.bins, "average in this many equal bins along the line (default: one row per particle)");
-  profile->add_flag("--grid", pa.grid, "on the grid: project the field onto the run's grid nodes (linear shape functions, mass-weighted) and profile the nodes near the line");
+  profile->add_option(
+      "--bins", pa.opt.bins,
+      "average in this many equal bins along the line (default: one row per particle)");
+  profile->add_flag("--grid", pa.grid,
+                    "on the grid: project the field onto the run's grid nodes (linear shape "
+                    "functions, mass-weighted) and profile the nodes near the line");
   profile->add_option("--time", pa.times, "the frame nearest this time, e.g. 9us (repeatable)");
-  profile->add_option("--frame", pa.frames, "frame index, 0 = first (repeatable); default: the last frame");
+  profile->add_option("--frame", pa.frames,
+                      "frame index, 0 = first (repeatable); default: the last frame");
   profile->add_flag("--json", pa.json, "print JSON (SI units)");
 
-  auto* render = app.add_subcommand("render", "PNG picture of a frame, off-screen (works without a display)");
+  auto* render =
+      app.add_subcommand("render", "PNG picture of a frame, off-screen (works without a display)");
   RenderArgs ra;
   render->add_option("input", input, "stream, - for stdin")->capture_default_str();
   render->add_option("-o,--output", ra.output, "PNG file")->capture_default_str();
-  render->add_option("--frame", ra.frame, "frame index (0 = first) or 'last'")->capture_default_str();
+  render->add_option("--frame", ra.frame, "frame index (0 = first) or 'last'")
+      ->capture_default_str();
   render->add_option("--time", ra.time, "the frame nearest this time, e.g. \"30.6 us\"");
-  render->add_option("--field", ra.opt.field, "colour by: a column (eps_p, rho, e, ...) or pressure, von_mises, speed")->capture_default_str();
-  render->add_option("--component", ra.opt.component, "component of a vector field (-1: magnitude)");
+  render
+      ->add_option("--field", ra.opt.field,
+                   "colour by: a column (eps_p, rho, e, ...) or pressure, von_mises, speed")
+      ->capture_default_str();
+  render->add_option("--component", ra.opt.component,
+                     "component of a vector field (-1: magnitude)");
   render->add_option("--view", ra.opt.view, "side, front, top or iso")
-      ->check(CLI::IsMember({"side", "front", "top", "iso"}))->capture_default_str();
-  render->add_option("--clip", ra.opt.clip, "keep one side of a plane through the centroid, e.g. \"y>0\"");
+      ->check(CLI::IsMember({"side", "front", "top", "iso"}))
+      ->capture_default_str();
+  render->add_option("--clip", ra.opt.clip,
+                     "keep one side of a plane through the centroid, e.g. \"y>0\"");
   render->add_option("--size", ra.size, "WIDTHxHEIGHT in pixels")->capture_default_str();
   render->add_option("--range", ra.range, "colour range MIN:MAX (SI units)");
   render->add_option("--title", ra.opt.title, "title text");
-  render->add_option("--radius", ra.opt.point_radius, "particle radius in m (default from mass and density)");
-  render->add_flag("--half", ra.half,
-                   "axisymmetric frames: draw the half plane r >= 0 only (default: the whole section, mirrored "
-                   "about the axis)");
+  render->add_option("--radius", ra.opt.point_radius,
+                     "particle radius in m (default from mass and density)");
+  render->add_flag(
+      "--half", ra.half,
+      "axisymmetric frames: draw the half plane r >= 0 only (default: the whole section, mirrored "
+      "about the axis)");
 
   try {
     app.parse(argc, argv);

@@ -3,16 +3,17 @@
 //   mpm-prep scene.toml --set grid.cell_size="0.38 mm" | mpm-run | mpm-post taylor -
 #include <CLI/CLI.hpp>
 
-#include "mpm/cli.hpp"
-#include "mpm/error.hpp"
-#include "mpm/prep.hpp"
-#include "mpm/version.hpp"
+#include "mpm/core/cli.hpp"
+#include "mpm/core/error.hpp"
+#include "mpm/core/version.hpp"
+#include "mpm/prep/prep.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"mpm-prep: turn a scene (TOML, see docs/scene.md) into a model stream of\n"
-               "particles for mpm-run. Prints a summary on stderr. Exit status: 0 done,\n"
-               "2 bad input, 4 write failure.",
-               "mpm-prep"};
+  CLI::App app{
+      "mpm-prep: turn a scene (TOML, see docs/scene.md) into a model stream of\n"
+      "particles for mpm-run. Prints a summary on stderr. Exit status: 0 done,\n"
+      "2 bad input, 4 write failure.",
+      "mpm-prep"};
   mpm::PrepOptions opt;
   app.add_option("scene", opt.scene, "scene file, - for stdin")->required();
   app.add_option("-o,--output", opt.output, "model stream, - for stdout")->capture_default_str();

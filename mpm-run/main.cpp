@@ -2,17 +2,18 @@
 //   mpm-prep scene.toml | mpm-run --threads 2 --stats | mpm-post taylor -
 #include <CLI/CLI.hpp>
 
-#include "mpm/cli.hpp"
-#include "mpm/error.hpp"
-#include "mpm/run.hpp"
-#include "mpm/version.hpp"
+#include "mpm/core/cli.hpp"
+#include "mpm/core/error.hpp"
+#include "mpm/core/version.hpp"
+#include "mpm/run/run.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"mpm-run: explicit material point method solver.\n"
-               "Reads a model stream (from mpm-prep) and writes a result stream of frames and\n"
-               "histories (for mpm-post). Exit status: 0 done, 2 bad input, 3 unstable run,\n"
-               "4 write failure, 128+N killed by signal N.",
-               "mpm-run"};
+  CLI::App app{
+      "mpm-run: explicit material point method solver.\n"
+      "Reads a model stream (from mpm-prep) and writes a result stream of frames and\n"
+      "histories (for mpm-post). Exit status: 0 done, 2 bad input, 3 unstable run,\n"
+      "4 write failure, 128+N killed by signal N.",
+      "mpm-run"};
   mpm::RunOptions opt;
   std::string progress = "auto";
   app.add_option("input", opt.input, "model stream, - for stdin")->capture_default_str();

@@ -35,7 +35,8 @@ inline std::filesystem::path temp_dir(const std::string& name) {
 /// Runs `cmd` with bash (pipefail on), stdout and stderr to files in `dir`.
 inline Result run(const std::string& cmd, const std::filesystem::path& dir) {
   const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string full = "bash -o pipefail -c '" + cmd + "' >" + out.string() + " 2>" + err.string() + " </dev/null";
+  const std::string full =
+      "bash -o pipefail -c '" + cmd + "' >" + out.string() + " 2>" + err.string() + " </dev/null";
   const int rc = std::system(full.c_str());
   Result r;
   r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
@@ -59,8 +60,8 @@ inline const std::string post = MPM_POST;
 /// `mpm-prep SCENE PREP_ARGS | mpm-run --progress none -o OUT`, run in `dir`.
 inline Result prep_and_run(const std::filesystem::path& scene, const std::string& prep_args,
                            const std::filesystem::path& out, const std::filesystem::path& dir) {
-  return run(prep + " " + scene.string() + " " + prep_args + " | " + runner + " --progress none -o " +
-                 out.string(),
+  return run(prep + " " + scene.string() + " " + prep_args + " | " + runner +
+                 " --progress none -o " + out.string(),
              dir);
 }
 

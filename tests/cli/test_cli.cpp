@@ -2,12 +2,12 @@
 // message naming the file, line or key, and exit status 2 (never a crash).
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <cstring>
 #include <regex>
 
-#include "mpm/stream.hpp"
+#include "mpm/stream/stream.hpp"
 #include "run_command.hpp"
 
 namespace mpm {
@@ -38,7 +38,8 @@ TEST(Cli, HelpAndVersion) {
     EXPECT_NE(r.out.find("Exit status"), std::string::npos) << tool << r.out;
     r = run(tool + " --version", dir);
     EXPECT_EQ(r.status, 0);
-    EXPECT_TRUE(std::regex_search(r.out, std::regex("mpm-(prep|run|post) [0-9]+\\.[0-9]+\\.[0-9]+")))
+    EXPECT_TRUE(
+        std::regex_search(r.out, std::regex("mpm-(prep|run|post) [0-9]+\\.[0-9]+\\.[0-9]+")))
         << r.out;
     r = run(tool + " --no-such-option", dir);
     EXPECT_EQ(r.status, 2) << tool;
@@ -52,9 +53,9 @@ TEST(Cli, HelpAndVersion) {
 
 TEST(Cli, PipelineRunsAndReports) {
   const auto dir = temp_dir("pipeline");
-  Result r = run(prep + " " + kBlock.string() + " | " + runner + " --progress none | " + post +
-                     " summary -",
-                 dir);
+  Result r = run(
+      prep + " " + kBlock.string() + " | " + runner + " --progress none | " + post + " summary -",
+      dir);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("frames: 5"), std::string::npos) << r.out;  // initial + 4
   EXPECT_NE(r.out.find("status 0"), std::string::npos) << r.out;
@@ -80,20 +81,26 @@ TEST(Cli, BadScenesAreReportedWithFileLineAndKey) {
       {"poisson2.toml", "poisson_ratio = 0.3", "poisson_ratio = 0.62", {"poisson_ratio"}},
       {"wrong_unit.toml", "\"200 GPa\"", "\"200 m/s\"", {"youngs_modulus", "velocity"}},
       {"no_particles.toml", "translate = \"0 0 2 mm\"", "translate = \"0 0 50 mm\"", {"block"}},
-      {"open_mesh.toml", "shape = \"box\"\nsize = \"4 4 4 mm\"",
-       "shape = \"mesh\"\nfile = \"open.off\"", {"open.off", "closed"}},
-      {"missing_mesh.toml", "shape = \"box\"\nsize = \"4 4 4 mm\"",
-       "shape = \"mesh\"\nfile = \"nowhere.stl\"", {"nowhere.stl"}},
+      {"open_mesh.toml",
+       "shape = \"box\"\nsize = \"4 4 4 mm\"",
+       "shape = \"mesh\"\nfile = \"open.off\"",
+       {"open.off", "closed"}},
+      {"missing_mesh.toml",
+       "shape = \"box\"\nsize = \"4 4 4 mm\"",
+       "shape = \"mesh\"\nfile = \"nowhere.stl\"",
+       {"nowhere.stl"}},
   };
   // An open mesh: a cube without its top face.
-  std::ofstream(dir / "open.off") << "OFF\n8 5 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
-                                     "4 0 3 2 1\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n";
+  std::ofstream(dir / "open.off")
+      << "OFF\n8 5 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+         "4 0 3 2 1\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n";
   for (const auto& c : cases) {
     const fs::path scene = variant(dir, c.name, c.from, c.to);
     Result r = run(prep + " " + scene.string() + " -o " + (dir / "model.mpm").string(), dir);
     EXPECT_EQ(r.status, 2) << c.name << "\n" << r.err;
     EXPECT_NE(r.err.find("error"), std::string::npos) << c.name;
-    for (const auto& frag : c.expect) EXPECT_NE(r.err.find(frag), std::string::npos) << c.name << ": " << r.err;
+    for (const auto& frag : c.expect)
+      EXPECT_NE(r.err.find(frag), std::string::npos) << c.name << ": " << r.err;
     EXPECT_EQ(r.err.find("internal error"), std::string::npos) << c.name;
   }
   // A line number: the unknown key sits on a known line of the file.
@@ -114,7 +121,8 @@ TEST(Cli, BadScenesAreReportedWithFileLineAndKey) {
 TEST(Cli, DamagedStreamsKeepTheFramesBefore) {
   const auto dir = temp_dir("damaged");
   const fs::path out = dir / "run.mpm";
-  Result r = run(prep + " " + kBlock.string() + " | " + runner + " --progress none -o " + out.string(), dir);
+  Result r = run(
+      prep + " " + kBlock.string() + " | " + runner + " --progress none -o " + out.string(), dir);
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string bytes = slurp(out);
   ASSERT_GT(bytes.size(), 1000u);
@@ -153,7 +161,9 @@ TEST(Cli, DamagedStreamsKeepTheFramesBefore) {
   r = run(runner + " /dev/null -o /dev/null", dir);
   EXPECT_EQ(r.status, 2);
   // Overrides of the geometry belong to mpm-prep.
-  r = run(runner + " " + (dir / "model.mpm").string() + " --set bodies.block.velocity=1 -o /dev/null", dir);
+  r = run(
+      runner + " " + (dir / "model.mpm").string() + " --set bodies.block.velocity=1 -o /dev/null",
+      dir);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("mpm-prep"), std::string::npos);
 }
@@ -163,10 +173,11 @@ TEST(Cli, DamagedStreamsKeepTheFramesBefore) {
 TEST(Cli, UnstableRunStopsAndKeepsItsFrames) {
   const auto dir = temp_dir("unstable");
   const fs::path out = dir / "run.mpm";
-  Result r = run(prep + " " + kBlock.string() +
-                     " --set solver.cfl=6 --set output.frames=40 --set solver.end_time=\"40 us\" | " +
-                     runner + " --progress none -o " + out.string(),
-                 dir);
+  Result r =
+      run(prep + " " + kBlock.string() +
+              " --set solver.cfl=6 --set output.frames=40 --set solver.end_time=\"40 us\" | " +
+              runner + " --progress none -o " + out.string(),
+          dir);
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_NE(r.err.find("unstable at step"), std::string::npos) << r.err;
   r = run(post + " summary " + out.string(), dir);
@@ -184,10 +195,13 @@ TEST(Cli, SparseGridRunsAndRefusesWhatItCannotDo) {
   const std::string model = (dir / "m.mpm").string();
   Result r = run(runner + " " + model + " --progress none -o " + (dir / "dense.mpm").string(), dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  r = run(runner + " " + model + " --progress none --set grid.sparse=true -o " + (dir / "sparse.mpm").string(), dir);
+  r = run(runner + " " + model + " --progress none --set grid.sparse=true -o " +
+              (dir / "sparse.mpm").string(),
+          dir);
   ASSERT_EQ(r.status, 0) << r.err;
   r = run(post + " particles " + (dir / "dense.mpm").string() + " --columns x,v,sigma", dir);
-  Result q = run(post + " particles " + (dir / "sparse.mpm").string() + " --columns x,v,sigma", dir);
+  Result q =
+      run(post + " particles " + (dir / "sparse.mpm").string() + " --columns x,v,sigma", dir);
   ASSERT_EQ(r.status, 0);
   EXPECT_EQ(r.out, q.out);
   const auto refused = [&](const std::string& args, const std::string& frag) {
@@ -198,9 +212,10 @@ TEST(Cli, SparseGridRunsAndRefusesWhatItCannotDo) {
   refused("--set grid.sparse=yes", "grid.sparse");
   refused("--set grid.sparse=true --set solver.type=implicit", "grid.sparse");
   refused("--set grid.sparse=true --strategy patch", "patch");
-  const fs::path graded = variant(dir, "sparse_levels.toml", "[boundary]",
-                                  "sparse = true\n\n[[grid.levels]]\nlevel = 2\nmin = \"-2 -2 0 mm\"\n"
-                                  "max = \"2 2 4 mm\"\n\n[boundary]");
+  const fs::path graded =
+      variant(dir, "sparse_levels.toml", "[boundary]",
+              "sparse = true\n\n[[grid.levels]]\nlevel = 2\nmin = \"-2 -2 0 mm\"\n"
+              "max = \"2 2 4 mm\"\n\n[boundary]");
   r = run(prep + " " + graded.string() + " -o /dev/null", dir);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("sparse_levels.toml:"), std::string::npos) << r.err;
@@ -215,7 +230,8 @@ TEST(Cli, PrepWarnsOfAnAbsurdStepCount) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
   r = run(prep + " " + kBlock.string() + " --set materials.steel.density=7.8e-12 -o " +
-              (dir / "m.mpm").string(), dir);
+              (dir / "m.mpm").string(),
+          dir);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("warning: about"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("explicit steps"), std::string::npos) << r.err;
@@ -259,8 +275,9 @@ TEST(Cli, OutputOverItsOwnInputIsRefused) {
     EXPECT_NE(r.err.find("is the input file"), std::string::npos) << c << "\n" << r.err;
   }
   // An output that is a directory (VTK's PNG writer used to spin on one for ever).
-  for (const std::string& c : {prep + " scene.toml -o .", runner + " model.mpm -o .",
-                               post + " history result.mpm -o .", post + " render result.mpm -o ."}) {
+  for (const std::string& c :
+       {prep + " scene.toml -o .", runner + " model.mpm -o .", post + " history result.mpm -o .",
+        post + " render result.mpm -o ."}) {
     r = run(cd + "timeout 120 " + c, dir);
     EXPECT_EQ(r.status, 2) << c << "\n" << r.err;
     EXPECT_NE(r.err.find("is a directory"), std::string::npos) << c << "\n" << r.err;
@@ -295,15 +312,19 @@ TEST(Cli, DeterministicFramesAtOneAndTwoThreads) {
   const auto dir = mpm::testing::temp_dir("deterministic");
   const std::string model = (dir / "model.mpm").string();
   using mpm::testing::run;
-  ASSERT_EQ(run(mpm::testing::prep + " " + (std::filesystem::path(MPM_TEST_DATA) / "cli" / "block.toml").string() +
+  ASSERT_EQ(run(mpm::testing::prep + " " +
+                    (std::filesystem::path(MPM_TEST_DATA) / "cli" / "block.toml").string() +
                     " -o " + model,
-                dir).status,
+                dir)
+                .status,
             0);
   for (int t : {1, 2})
-    ASSERT_EQ(run(mpm::testing::runner + " " + model + " --deterministic --threads " + std::to_string(t) +
-                      " --progress none -o " + (dir / ("t" + std::to_string(t) + ".mpm")).string(),
-                  dir).status,
-              0);
+    ASSERT_EQ(
+        run(mpm::testing::runner + " " + model + " --deterministic --threads " + std::to_string(t) +
+                " --progress none -o " + (dir / ("t" + std::to_string(t) + ".mpm")).string(),
+            dir)
+            .status,
+        0);
   const auto a = frames_of((dir / "t1.mpm").string()), b = frames_of((dir / "t2.mpm").string());
   ASSERT_EQ(a.size(), b.size());
   ASSERT_GT(a.size(), 2u);
@@ -312,13 +333,16 @@ TEST(Cli, DeterministicFramesAtOneAndTwoThreads) {
     for (const auto& c : a[k].columns.columns()) {
       const Column& d = b[k].columns.at(c.info().name);
       ASSERT_EQ(c.bytes(), d.bytes());
-      EXPECT_EQ(std::memcmp(c.data(), d.data(), c.bytes()), 0) << "frame " << k << " column " << c.info().name;
+      EXPECT_EQ(std::memcmp(c.data(), d.data(), c.bytes()), 0)
+          << "frame " << k << " column " << c.info().name;
     }
   }
-  const auto r = run(mpm::testing::runner + " " + model + " --deterministic --strategy patch -o /dev/null", dir);
+  const auto r = run(
+      mpm::testing::runner + " " + model + " --deterministic --strategy patch -o /dev/null", dir);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("--deterministic"), std::string::npos) << r.err;
-  EXPECT_EQ(run(mpm::testing::runner + " " + model + " --strategy bogus -o /dev/null", dir).status, 2);
+  EXPECT_EQ(run(mpm::testing::runner + " " + model + " --strategy bogus -o /dev/null", dir).status,
+            2);
 }
 
 }  // namespace

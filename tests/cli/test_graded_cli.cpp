@@ -29,7 +29,8 @@ fs::path graded_block(const fs::path& dir, const std::string& levels) {
   return p;
 }
 
-const std::string kLevel = "\n[[grid.levels]]\nlevel = 2\nmin = \"-3 -3 0 mm\"\nmax = \"3 3 2 mm\"\n";
+const std::string kLevel =
+    "\n[[grid.levels]]\nlevel = 2\nmin = \"-3 -3 0 mm\"\nmax = \"3 3 2 mm\"\n";
 
 TEST(GradedCli, PipelineWritesTheGridAndSplits) {
   const auto dir = temp_dir("graded_pipeline");
@@ -38,7 +39,9 @@ TEST(GradedCli, PipelineWritesTheGridAndSplits) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("graded grid:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("level 2: cell 0.5 mm"), std::string::npos) << r.err;
-  r = run(runner + " " + (dir / "model.mpm").string() + " -o " + (dir / "run.mpm").string() + " --stats --progress none", dir);
+  r = run(runner + " " + (dir / "model.mpm").string() + " -o " + (dir / "run.mpm").string() +
+              " --stats --progress none",
+          dir);
   ASSERT_EQ(r.status, 0) << r.err;
   // The block falls 0.4 mm into the level-2 box: its coarse particles there split.
   EXPECT_NE(r.err.find("graded grid: 2 levels"), std::string::npos) << r.err;
@@ -53,7 +56,8 @@ TEST(GradedCli, PipelineWritesTheGridAndSplits) {
   EXPECT_NE(vtu.find("Name=\"hanging\""), std::string::npos);
   EXPECT_NE(r.err.find("1 graded grid(s)"), std::string::npos) << r.err;
   // The model stream holds the grid too.
-  r = run(post + " vtk " + (dir / "model.mpm").string() + " -o " + (dir / "model_vtk").string(), dir);
+  r = run(post + " vtk " + (dir / "model.mpm").string() + " -o " + (dir / "model_vtk").string(),
+          dir);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir / "model_vtk" / "frame_grid_0000.vtu"));
 }
@@ -62,15 +66,23 @@ TEST(GradedCli, ProfileAlongALine) {
   const auto dir = temp_dir("graded_profile");
   const fs::path scene = graded_block(dir, kLevel);
   ASSERT_EQ(run(prep + " " + scene.string() + " | " + runner + " --progress none -o " +
-                    (dir / "run.mpm").string(), dir).status, 0);
+                    (dir / "run.mpm").string(),
+                dir)
+                .status,
+            0);
   const std::string file = (dir / "run.mpm").string();
-  Result r = run(post + " profile " + file + " --field sigma --component zz --along z --bins 4", dir);
+  Result r =
+      run(post + " profile " + file + " --field sigma --component zz --along z --bins 4", dir);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.out.rfind("time,s,value,min,max,count,weight\n", 0), 0u) << r.out;
   EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 5) << r.out;  // header + 4 bins
-  r = run(post + " profile " + file + " --field speed --from \"0 0 0 mm\" --to \"0 0 4 mm\" --radius \"1 mm\" --time 2us --time 4us --json", dir);
+  r = run(post + " profile " + file +
+              " --field speed --from \"0 0 0 mm\" --to \"0 0 4 mm\" --radius \"1 mm\" --time 2us "
+              "--time 4us --json",
+          dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.out.find("\"profiles\": [{\"time\": 2e-06"), std::string::npos) << r.out.substr(0, 300);
+  EXPECT_NE(r.out.find("\"profiles\": [{\"time\": 2e-06"), std::string::npos)
+      << r.out.substr(0, 300);
   EXPECT_NE(r.out.find("{\"time\": 4e-06"), std::string::npos);
   r = run(post + " profile " + file + " --field nope", dir);
   EXPECT_EQ(r.status, 2);
@@ -84,14 +96,17 @@ TEST(GradedCli, ProfileAlongALine) {
 TEST(GradedCli, BadLevelBoxesAreReportedWithFileLineAndKey) {
   const auto dir = temp_dir("graded_bad");
   // Off the level-1 lattice (1 mm from the domain's corner).
-  fs::path scene = graded_block(dir, "\n[[grid.levels]]\nlevel = 2\nmin = \"-2.5 -3 0 mm\"\nmax = \"3 3 2 mm\"\n");
+  fs::path scene = graded_block(
+      dir, "\n[[grid.levels]]\nlevel = 2\nmin = \"-2.5 -3 0 mm\"\nmax = \"3 3 2 mm\"\n");
   Result r = run(prep + " " + scene.string() + " -o " + (dir / "m.mpm").string(), dir);
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("graded.toml:31: grid.levels.0.min: a level-2 box must lie on the level-1 lattice"),
+  EXPECT_NE(r.err.find(
+                "graded.toml:31: grid.levels.0.min: a level-2 box must lie on the level-1 lattice"),
             std::string::npos)
       << r.err;
   // A level-3 box against the side of the level-2 box.
-  scene = graded_block(dir, kLevel + "\n[[grid.levels]]\nlevel = 3\nmin = \"-3 -1 0 mm\"\nmax = \"-2 1 1 mm\"\n");
+  scene = graded_block(
+      dir, kLevel + "\n[[grid.levels]]\nlevel = 3\nmin = \"-3 -1 0 mm\"\nmax = \"-2 1 1 mm\"\n");
   r = run(prep + " " + scene.string() + " -o " + (dir / "m.mpm").string(), dir);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("grid.levels.1: the level-3 box"), std::string::npos) << r.err;

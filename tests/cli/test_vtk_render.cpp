@@ -2,11 +2,11 @@
 // deformed block coloured by plastic strain on a machine with no display, and draws an
 // axisymmetric frame as the whole section through the axis.
 #include <gtest/gtest.h>
-#include <vtkPNGReader.h>
-#include <vtkPointData.h>
 #include <vtkDataArray.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
+#include <vtkPNGReader.h>
+#include <vtkPointData.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLUnstructuredGridReader.h>
 
@@ -25,7 +25,8 @@ TEST(Cli, VtkSeriesReadsBackAndRenderWorksHeadless) {
   const auto dir = temp_dir("vtk_render");
   const fs::path scene = fs::path(MPM_TEST_DATA) / "cli" / "block.toml";
   const fs::path out = dir / "run.mpm";
-  Result r = run(prep + " " + scene.string() + " | " + runner + " --progress none -o " + out.string(), dir);
+  Result r = run(
+      prep + " " + scene.string() + " | " + runner + " --progress none -o " + out.string(), dir);
   ASSERT_EQ(r.status, 0) << r.err;
   r = run(post + " vtk " + out.string() + " -o " + (dir / "vtk").string() + " --name block", dir);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -45,8 +46,8 @@ TEST(Cli, VtkSeriesReadsBackAndRenderWorksHeadless) {
   g->GetPointData()->GetArray("eps_p")->GetRange(range);
   EXPECT_GT(range[1], 0.0);
 
-  r = run("env -u DISPLAY " + post + " render " + out.string() + " -o " + (dir / "block.png").string() +
-              " --field eps_p --size 640x480",
+  r = run("env -u DISPLAY " + post + " render " + out.string() + " -o " +
+              (dir / "block.png").string() + " --field eps_p --size 640x480",
           dir);
   ASSERT_EQ(r.status, 0) << r.err;
   vtkNew<vtkPNGReader> png;

@@ -8,8 +8,8 @@
 // (166.8 / 133.1 mm at 1.06 mm cells), so 5% bands around the converged values hold the coarse
 // run and fail if the axisymmetric physics or the measure breaks (counting the rings instead of
 // weighing them puts this run's front at 174.9 mm, +6.6%; the unit test
-// Debris.AxisymmetricCloudWeighsRingsByTheirMass checks the measure exactly). The front stays behind
-// the on-axis bound of this equation of state, 182 mm (results.md, "On the axis, in 1D").
+// Debris.AxisymmetricCloudWeighsRingsByTheirMass checks the measure exactly). The front stays
+// behind the on-axis bound of this equation of state, 182 mm (results.md, "On the axis, in 1D").
 // Energy: the leapfrog total gains 0.67% at this resolution (0.47% at 0.265 mm cells), 0.50% of
 // it in the first microsecond (the contact); at most 1%.
 #include <gtest/gtest.h>

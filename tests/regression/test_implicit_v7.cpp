@@ -69,8 +69,8 @@ Case run_case(const std::string& name) {
 }
 
 /// The deformable particles of the last frame.
-std::vector<std::map<std::string, double>> material(const Case& c,
-                                                    const std::string& columns = "x,m,sigma,material") {
+std::vector<std::map<std::string, double>> material(
+    const Case& c, const std::string& columns = "x,m,sigma,material") {
   const Result r = run(post + " particles " + c.stream.string() + " --columns " + columns, c.dir);
   EXPECT_EQ(r.status, 0) << r.err;
   auto rows = csv(r.out);
@@ -129,7 +129,8 @@ void bar(const std::string& name) {
     }
   }
   if (c.ref["thickness_tolerance"]) {  // plane stress: ln(h / h0) = eps_zz = -nu / E (s_xx + s_yy)
-    const double E = c.ref["youngs_modulus"].value_or(0.0), nu = c.ref["poisson_ratio"].value_or(0.0);
+    const double E = c.ref["youngs_modulus"].value_or(0.0),
+                 nu = c.ref["poisson_ratio"].value_or(0.0);
     for (auto& p : material(c, "x,sigma,thickness,material")) {
       const double ezz = -nu / E * (p.at("sigma_0") + p.at("sigma_1"));
       EXPECT_NEAR(std::log(p.at("thickness")), ezz,
@@ -177,7 +178,8 @@ TEST(RegressionImplicit, PreviousStepGuessSavesNewtonWork) {
   std::map<std::string, std::pair<double, double>> got;  // guess -> (evaluations, sigma_xx)
   for (const std::string guess : {"particles", "previous"}) {
     const Case c = run_case("guess_" + guess);
-    const Result h = run(post + " history " + c.stream.string() + " --columns residual_evals_total", c.dir);
+    const Result h =
+        run(post + " history " + c.stream.string() + " --columns residual_evals_total", c.dir);
     ASSERT_EQ(h.status, 0) << h.err;
     double sum = 0;
     const auto rows = material(c, "sigma,material");

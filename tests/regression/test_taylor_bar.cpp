@@ -1,7 +1,6 @@
 // The Taylor bar example at its coarse default through the whole pipeline, against the seed
 // authors' code at the same resolution (reference values and tolerance in taylor_bar.toml).
 #include <gtest/gtest.h>
-
 #include <toml++/toml.h>
 
 #include "cli/run_command.hpp"
@@ -14,14 +13,15 @@ namespace fs = std::filesystem;
 
 TEST(Regression, TaylorBarCoarse) {
   const auto dir = temp_dir("taylor_coarse");
-  const toml::table ref = toml::parse_file((fs::path(__FILE__).parent_path() / "taylor_bar.toml").string());
+  const toml::table ref =
+      toml::parse_file((fs::path(__FILE__).parent_path() / "taylor_bar.toml").string());
   const fs::path scene = fs::path(MPM_EXAMPLES) / ref["scene"].value_or(std::string());
   const std::string cell = ref["cell_size"].value_or(std::string());
   const double L = ref["L"].value_or(0.0), D = ref["D"].value_or(0.0);
   const double tol = ref["tolerance"].value_or(0.0);
   const fs::path out = dir / "taylor.mpm";
-  Result r = run(prep + " " + scene.string() + " --set grid.cell_size=\"" + cell + "\" | " + runner +
-                     " --progress none -o " + out.string(),
+  Result r = run(prep + " " + scene.string() + " --set grid.cell_size=\"" + cell + "\" | " +
+                     runner + " --progress none -o " + out.string(),
                  dir);
   ASSERT_EQ(r.status, 0) << r.err;
   r = run(post + " taylor " + out.string() + " --json", dir);

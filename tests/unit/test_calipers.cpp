@@ -6,12 +6,12 @@
 #include <cstdint>
 #include <numbers>
 
-#include "mpm/calipers.hpp"
-#include "mpm/error.hpp"
-#include "mpm/particles.hpp"
-#include "mpm/post.hpp"
-#include "mpm/scene.hpp"
-#include "mpm/stream.hpp"
+#include "mpm/core/error.hpp"
+#include "mpm/post/calipers.hpp"
+#include "mpm/post/post.hpp"
+#include "mpm/scene/particles.hpp"
+#include "mpm/scene/scene.hpp"
+#include "mpm/stream/stream.hpp"
 
 namespace mpm {
 namespace {
@@ -30,7 +30,8 @@ TEST(Calipers, FilledSquareAtAnyAngle) {
       y.push_back(u * std::sin(th) + v * std::cos(th) - 3);
     }
   const Calipers c = caliper_widths(x, y);
-  EXPECT_GE(c.hull_vertices, 4u);  // edge points turned by 30 degrees may leave the line by round-off
+  EXPECT_GE(c.hull_vertices,
+            4u);  // edge points turned by 30 degrees may leave the line by round-off
   EXPECT_NEAR(c.mean, 4 * a / kPi, 1e-12);
   EXPECT_NEAR(c.min, a, 1e-12);
   EXPECT_NEAR(c.max, a * std::sqrt(2.0), 1e-12);
@@ -42,7 +43,8 @@ TEST(Calipers, RegularPolygon) {
   const double R = 3.0;
   const int n = 12;
   std::vector<double> x, y;
-  for (int k = 0; k < n; ++k) x.push_back(R * std::cos(2 * kPi * k / n)), y.push_back(R * std::sin(2 * kPi * k / n));
+  for (int k = 0; k < n; ++k)
+    x.push_back(R * std::cos(2 * kPi * k / n)), y.push_back(R * std::sin(2 * kPi * k / n));
   x.push_back(0), y.push_back(0);  // an interior point
   const Calipers c = caliper_widths(x, y);
   EXPECT_EQ(c.hull_vertices, std::size_t(n));
@@ -123,7 +125,8 @@ TEST(TaylorMeter, RoundFootGivesItsDiameter) {
   for (int k = 0; k < 720; ++k)
     xs.insert(xs.end(), {R * std::cos(2 * kPi * k / 720), R * std::sin(2 * kPi * k / 720), 0.5e-3});
   for (int k = 1; k <= 20; ++k) xs.insert(xs.end(), {0, 0, 0.5e-3 + k * 1e-3});
-  const TaylorResult r = TaylorMeter(bar_scene(3, false), TaylorOptions{}).measure(bar_frame(xs, 3));
+  const TaylorResult r =
+      TaylorMeter(bar_scene(3, false), TaylorOptions{}).measure(bar_frame(xs, 3));
   EXPECT_NEAR(r.D, 2 * R, 1e-3 * 2 * R);
   EXPECT_NEAR(r.D_max, 2 * R, 1e-12);
   EXPECT_NEAR(r.D_radius, 2 * R, 1e-12);
@@ -135,7 +138,8 @@ TEST(TaylorMeter, PlaneStrainWidthAndAxisymmetricRadius) {
   std::vector<double> xs;
   for (int i = 0; i <= 10; ++i) xs.insert(xs.end(), {1e-3 + i * 1e-3, 0.5e-3});  // foot: x 1..11 mm
   for (int k = 1; k <= 20; ++k) xs.insert(xs.end(), {3e-3, 0.5e-3 + k * 1e-3});
-  const TaylorResult p = TaylorMeter(bar_scene(2, false), TaylorOptions{}).measure(bar_frame(xs, 2));
+  const TaylorResult p =
+      TaylorMeter(bar_scene(2, false), TaylorOptions{}).measure(bar_frame(xs, 2));
   EXPECT_EQ(p.axis, 1);
   EXPECT_NEAR(p.D, 10e-3, 1e-15);
   const TaylorResult a = TaylorMeter(bar_scene(2, true), TaylorOptions{}).measure(bar_frame(xs, 2));

@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "mpm/columns.hpp"
+#include "mpm/core/columns.hpp"
 
 namespace mpm {
 namespace {

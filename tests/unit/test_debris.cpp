@@ -6,11 +6,11 @@
 #include <cmath>
 #include <cstdint>
 
-#include "mpm/error.hpp"
-#include "mpm/particles.hpp"
-#include "mpm/post.hpp"
-#include "mpm/scene.hpp"
-#include "mpm/stream.hpp"
+#include "mpm/core/error.hpp"
+#include "mpm/post/post.hpp"
+#include "mpm/scene/particles.hpp"
+#include "mpm/scene/scene.hpp"
+#include "mpm/stream/stream.hpp"
 
 namespace mpm {
 namespace {
@@ -178,7 +178,7 @@ TEST(Debris, FragmentsLinkTransitivelyAcrossBins) {
       for (int j = 0; j < 3; ++j)
         for (int k = 0; k < 3; ++k) blocks.push_back(Vec3(x0 + 0.5e-3 * i, 0.5e-3 * j, 0.5e-3 * k));
   const std::vector<std::size_t> s = fragment_sizes(blocks, link);
-  for (std::size_t i = 0; i < 54; ++i) EXPECT_EQ(s[i], 54u);  // 1.9 - 1.0 = 0.9 mm: linked
+  for (std::size_t i = 0; i < 54; ++i) EXPECT_EQ(s[i], 54u);   // 1.9 - 1.0 = 0.9 mm: linked
   for (std::size_t i = 54; i < 81; ++i) EXPECT_EQ(s[i], 27u);  // 5.1 - 2.9 = 2.2 mm: apart
 }
 

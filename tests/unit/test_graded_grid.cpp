@@ -7,10 +7,10 @@
 
 #include <random>
 
-#include "mpm/error.hpp"
-#include "mpm/graded_grid.hpp"
-#include "mpm/lattice.hpp"
-#include "mpm/scene.hpp"
+#include "mpm/core/error.hpp"
+#include "mpm/grid/graded_grid.hpp"
+#include "mpm/grid/lattice.hpp"
+#include "mpm/scene/scene.hpp"
 
 namespace mpm {
 namespace {
@@ -68,8 +68,8 @@ TEST(GradedGrid, CountsCellsTransitionCellsAndHangingNodes) {
   EXPECT_EQ(g.hanging_nodes(), 2u * ((729 - 343) - (125 - 27)));
   EXPECT_DOUBLE_EQ(g.min_cell_size(), 0.25e-3);
   const GradedGrid<2> g2 = nested<2>();
-  EXPECT_EQ(g2.transition_cells(), 2u * (4 * 4));                  // 4 edges x 4 cells
-  EXPECT_EQ(g2.hanging_nodes(), 2u * (32 - 16));  // fine minus coarse nodes on each perimeter
+  EXPECT_EQ(g2.transition_cells(), 2u * (4 * 4));  // 4 edges x 4 cells
+  EXPECT_EQ(g2.hanging_nodes(), 2u * (32 - 16));   // fine minus coarse nodes on each perimeter
 }
 
 /// Random nodal values; the value at x from the cell `key` (x may lie on the cell's boundary).
@@ -123,8 +123,12 @@ void continuity() {
   EXPECT_GT(interface_points, D == 3 ? 2000 : 100);
 }
 
-TEST(GradedGrid, ContinuousAcrossEveryLevelInterface3D) { continuity<3>(); }
-TEST(GradedGrid, ContinuousAcrossEveryLevelInterface2D) { continuity<2>(); }
+TEST(GradedGrid, ContinuousAcrossEveryLevelInterface3D) {
+  continuity<3>();
+}
+TEST(GradedGrid, ContinuousAcrossEveryLevelInterface2D) {
+  continuity<2>();
+}
 
 // Patch test: nodal values of a linear velocity field v = v0 + B x; every cell, transition
 // cells included, reproduces v and its gradient B exactly at any point. Tolerances: 1e-12 of
@@ -168,8 +172,12 @@ void patch_test() {
   EXPECT_GT(transition, 0);
 }
 
-TEST(GradedGrid, PatchTestLinearVelocityThroughTransitionCells3D) { patch_test<3>(); }
-TEST(GradedGrid, PatchTestLinearVelocityThroughTransitionCells2D) { patch_test<2>(); }
+TEST(GradedGrid, PatchTestLinearVelocityThroughTransitionCells3D) {
+  patch_test<3>();
+}
+TEST(GradedGrid, PatchTestLinearVelocityThroughTransitionCells2D) {
+  patch_test<2>();
+}
 
 // A point walking along a diagonal through levels 1, 2, 3, 2, 1 in steps of 1/37 of the
 // finest cell: its weights stay non-negative and sum to one (to rounding, 1e-14), and its
@@ -227,11 +235,19 @@ void in_cell_matches_locate() {
   }
 }
 
-TEST(GradedGrid, BinFastPathAgreesWithLocateBitForBit3D) { in_cell_matches_locate<3>(); }
-TEST(GradedGrid, BinFastPathAgreesWithLocateBitForBit2D) { in_cell_matches_locate<2>(); }
+TEST(GradedGrid, BinFastPathAgreesWithLocateBitForBit3D) {
+  in_cell_matches_locate<3>();
+}
+TEST(GradedGrid, BinFastPathAgreesWithLocateBitForBit2D) {
+  in_cell_matches_locate<2>();
+}
 
-TEST(GradedGrid, WalkingPointKeepsWeightsSummingToOne3D) { walk<3>(); }
-TEST(GradedGrid, WalkingPointKeepsWeightsSummingToOne2D) { walk<2>(); }
+TEST(GradedGrid, WalkingPointKeepsWeightsSummingToOne3D) {
+  walk<3>();
+}
+TEST(GradedGrid, WalkingPointKeepsWeightsSummingToOne2D) {
+  walk<2>();
+}
 
 // Keys are in slab-layer order, and a node is shared only by cells of one layer or of two
 // adjacent ones: chunks of whole layers two apart never touch the same node (binning.hpp).
@@ -281,8 +297,10 @@ std::string build_error(int dim, std::vector<LevelSpec> levels) {
   Lattice lat;
   const Scene s = graded_scene(dim, 8, std::move(levels), lat);
   try {
-    if (dim == 3) GradedGrid<3>(lat, s);
-    else GradedGrid<2>(lat, s);
+    if (dim == 3)
+      GradedGrid<3>(lat, s);
+    else
+      GradedGrid<2>(lat, s);
   } catch (const InputError& e) {
     return e.what();
   }
@@ -291,26 +309,38 @@ std::string build_error(int dim, std::vector<LevelSpec> levels) {
 
 TEST(GradedGrid, RejectsBoxesThatBreakTheRules) {
   // A level-3 box against the side of the level-2 box: cells two levels apart would touch.
-  EXPECT_PRED2(contains, build_error(3, {box(2, Vec3::Constant(2), Vec3::Constant(6), 0),
-                              box(3, Vec3(2, 3, 3), Vec3(4, 5, 5), 1)}), "scene.toml:21: grid.levels.1: the level-3 box");
-  EXPECT_PRED2(contains, build_error(3, {box(2, Vec3::Constant(2), Vec3::Constant(6), 0),
-                              box(3, Vec3(2, 3, 3), Vec3(4, 5, 5), 1)}), "closer than one level-2 cell (0.5 mm)");
+  EXPECT_PRED2(contains,
+               build_error(3, {box(2, Vec3::Constant(2), Vec3::Constant(6), 0),
+                               box(3, Vec3(2, 3, 3), Vec3(4, 5, 5), 1)}),
+               "scene.toml:21: grid.levels.1: the level-3 box");
+  EXPECT_PRED2(contains,
+               build_error(3, {box(2, Vec3::Constant(2), Vec3::Constant(6), 0),
+                               box(3, Vec3(2, 3, 3), Vec3(4, 5, 5), 1)}),
+               "closer than one level-2 cell (0.5 mm)");
   // At the domain's face the same contact is fine.
   EXPECT_EQ(build_error(3, {box(2, Vec3(0, 2, 2), Vec3(4, 6, 6), 0),
                             box(3, Vec3(0, 3, 3), Vec3(2, 5, 5), 1)}),
             "");
   // Not nested.
-  EXPECT_PRED2(contains, build_error(3, {box(2, Vec3::Constant(2), Vec3::Constant(4), 0),
-                              box(3, Vec3::Constant(5), Vec3::Constant(6), 1)}), "is not inside the level-2 region");
+  EXPECT_PRED2(contains,
+               build_error(3, {box(2, Vec3::Constant(2), Vec3::Constant(4), 0),
+                               box(3, Vec3::Constant(5), Vec3::Constant(6), 1)}),
+               "is not inside the level-2 region");
   // Not on the coarser lattice.
-  EXPECT_PRED2(contains, build_error(3, {box(2, Vec3(2.5, 2, 2), Vec3::Constant(6), 0)}), "grid.levels.0.min: must lie on the level-1 lattice");
-  EXPECT_PRED2(contains, build_error(3, {box(3, Vec3::Constant(2), Vec3::Constant(6), 0)}), "needs level-2 boxes around it");
+  EXPECT_PRED2(contains, build_error(3, {box(2, Vec3(2.5, 2, 2), Vec3::Constant(6), 0)}),
+               "grid.levels.0.min: must lie on the level-1 lattice");
+  EXPECT_PRED2(contains, build_error(3, {box(3, Vec3::Constant(2), Vec3::Constant(6), 0)}),
+               "needs level-2 boxes around it");
   // Two level-2 boxes in an L: the coarse cell in the inner corner would have negative
   // shape functions (transition_shape tests).
-  EXPECT_PRED2(contains, build_error(3, {box(2, Vec3(2, 2, 2), Vec3(4, 6, 6), 0),
-                              box(2, Vec3(4, 4, 2), Vec3(6, 6, 6), 1)}), "concave corner");
-  EXPECT_PRED2(contains, build_error(2, {box(2, Vec3(2, 2, 0), Vec3(4, 6, 0), 0),
-                              box(2, Vec3(4, 4, 0), Vec3(6, 6, 0), 1)}), "concave corner");
+  EXPECT_PRED2(contains,
+               build_error(3, {box(2, Vec3(2, 2, 2), Vec3(4, 6, 6), 0),
+                               box(2, Vec3(4, 4, 2), Vec3(6, 6, 6), 1)}),
+               "concave corner");
+  EXPECT_PRED2(contains,
+               build_error(2, {box(2, Vec3(2, 2, 0), Vec3(4, 6, 0), 0),
+                               box(2, Vec3(4, 4, 0), Vec3(6, 6, 0), 1)}),
+               "concave corner");
   // Two boxes one coarse cell apart on opposite sides of it are fine.
   EXPECT_EQ(build_error(3, {box(2, Vec3(2, 2, 2), Vec3(4, 6, 6), 0),
                             box(2, Vec3(5, 2, 2), Vec3(7, 6, 6), 1)}),
@@ -363,12 +393,14 @@ follow = "b"
   EXPECT_EQ(error("[[grid.levels]]\nlevel = 2\nmin = \"3.5 3 3 mm\"\nmax = \"7 7 7 mm\"\n"),
             "s.toml:18: grid.levels.0.min: a level-2 box must lie on the level-1 lattice: x = 3.5 "
             "mm is not a multiple of 1 mm from grid.domain.min (nearest: 4 mm)");
-  EXPECT_EQ(error("[[grid.levels]]\nlevel = 2\nmin = \"3 3 3 mm\"\nmax = \"7 7 7 mm\"\nsize = 3\n"),
-            "s.toml:20: grid.levels.0.size: unknown key (expected one of: level, min, max, follow)");
+  EXPECT_EQ(
+      error("[[grid.levels]]\nlevel = 2\nmin = \"3 3 3 mm\"\nmax = \"7 7 7 mm\"\nsize = 3\n"),
+      "s.toml:20: grid.levels.0.size: unknown key (expected one of: level, min, max, follow)");
   EXPECT_EQ(error("[[grid.levels]]\nlevel = 1\nmin = \"3 3 3 mm\"\nmax = \"7 7 7 mm\"\n"),
             "s.toml:17: grid.levels.0.level: must be between 2 and 12, got 1");
-  EXPECT_EQ(error("[[grid.levels]]\nlevel = 2\nmin = \"3 3 3 mm\"\nmax = \"7 7 7 mm\"\nfollow = \"x\"\n"),
-            "s.toml:20: grid.levels.0.follow: unknown body 'x' (known: b)");
+  EXPECT_EQ(
+      error("[[grid.levels]]\nlevel = 2\nmin = \"3 3 3 mm\"\nmax = \"7 7 7 mm\"\nfollow = \"x\"\n"),
+      "s.toml:20: grid.levels.0.follow: unknown body 'x' (known: b)");
   EXPECT_EQ(error("[[grid.levels]]\nlevel = 2\nmin = \"3 3 3 mm\"\nmax = \"7 7 12 mm\"\n"),
             "s.toml:19: grid.levels.0.max: the box leaves grid.domain along z");
   EXPECT_EQ(error("[[grid.levels]]\nlevel = 2\nmin = \"3 3 3 mm\"\nmax = \"7 7 7 mm\"\n",

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "mpm/materials/material.hpp"
+#include "mpm/solver/materials/material.hpp"
 
 namespace mpm {
 namespace {
@@ -210,7 +210,7 @@ TEST(Materials, PressureWorkGoesIntoInternalEnergy) {
   Point p(spec.density);
   const double rate = -1e4, dt = 1e-8;
   Mat3 L = Mat3::Identity() * (rate / 3.0);  // isotropic compression
-  double work = 0;  // -integral p dV per unit mass, trapezoidal
+  double work = 0;                           // -integral p dV per unit mass, trapezoidal
   for (int k = 0; k < 2000; ++k) {
     const double p_old = -trace(p.sigma) / 3, v_old = 1 / p.rho;
     p.update(mat, L, dt);
@@ -401,7 +401,6 @@ TEST(Materials, JaumannRateRotatesWithoutChangingInvariants) {
   EXPECT_NE(p.sigma[5], 4e6);                        // it did rotate
 }
 
-
 // Plane stress, elastic: from rest, one small step with any in-plane rate gives the plane-stress
 // Hooke's law, sigma = E / (1 - nu^2) [eps_xx + nu eps_yy, eps_yy + nu eps_xx], sigma_xy = 2 G
 // eps_xy, sigma_zz = 0, and the density follows the thinning eps_zz = -nu / (1 - nu) (eps_xx +
@@ -456,7 +455,8 @@ TEST(Materials, HugoniotStateOfTheShockEstimate) {
     const double rho_H = lead.density * Us / (Us - u_p);
     EXPECT_NEAR(mat.hugoniot_density(u_p), rho_H, 1e-9 * rho_H) << "u_p " << u_p;
   }
-  EXPECT_NEAR(mat.hugoniot_density(3290.0), 21802.5, 0.1);  // Shock.SymmetricLeadImpactMatchesRankineHugoniot
+  EXPECT_NEAR(mat.hugoniot_density(3290.0), 21802.5,
+              0.1);  // Shock.SymmetricLeadImpactMatchesRankineHugoniot
   const double c0 = mat.reference_wave_speed();
   EXPECT_EQ(mat.shocked_signal_speed(0.0), c0);
   EXPECT_GT(mat.shocked_signal_speed(50.0), c0 + 50.0);

@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <random>
 
-#include "mpm/implicit/newton_krylov.hpp"
+#include "mpm/solver/implicit/newton_krylov.hpp"
 
 namespace mpm {
 namespace {

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "mpm/error.hpp"
-#include "mpm/scene.hpp"
+#include "mpm/core/error.hpp"
+#include "mpm/scene/scene.hpp"
 
 namespace mpm {
 namespace {
@@ -400,7 +400,8 @@ TEST(SceneErrors, FilesNameFileLineAndKey) {
        "materials.copper.densty: unknown key (expected one of: density, youngs_modulus, "
        "poisson_ratio, strength, eos, failure)"},
       {"bad_unknown_top.toml", 19,
-       "outptu: unknown key (expected one of: scene, materials, bodies, loads, grid, boundary, solver, "
+       "outptu: unknown key (expected one of: scene, materials, bodies, loads, grid, boundary, "
+       "solver, "
        "output)"},
       {"bad_unknown_nested.toml", 9, "materials.copper.strength.hardening: unknown key"},
       {"bad_unknown_material.toml", 8,
@@ -705,7 +706,8 @@ TEST(SceneOverrides, SettingSpacingOrParticlesPerCellReplacesTheOther) {
   // The document a model carries (the scene with its overrides) parses to the same body.
   const Scene again = parse_scene(s.toml, "model", "/scenes", {});
   EXPECT_EQ(again.bodies[0].particle_spacing, s.bodies[0].particle_spacing);
-  const Scene back = parse_scene(parse(sp, {"bodies.bar.particles_per_cell=4"}).toml, "model", "/scenes", {});
+  const Scene back =
+      parse_scene(parse(sp, {"bodies.bar.particles_per_cell=4"}).toml, "model", "/scenes", {});
   EXPECT_EQ(back.bodies[0].particle_spacing, 0.0);
   EXPECT_EQ(back.bodies[0].particles_per_cell, 4);
 }

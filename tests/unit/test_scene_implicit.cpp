@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <string>
 
-#include "mpm/error.hpp"
-#include "mpm/scene.hpp"
+#include "mpm/core/error.hpp"
+#include "mpm/scene/scene.hpp"
 
 namespace mpm {
 namespace {
@@ -62,13 +62,13 @@ TEST(SceneImplicit, DefaultsAreTheSeeds) {
   EXPECT_EQ(m.gmres_basis, 20);        // section 3.2.4
   EXPECT_EQ(m.ramp, 0.2);              // Tables 1-6: 20% a step
   EXPECT_EQ(m.dt_initial_multiple, 1.0);
-  EXPECT_EQ(m.forcing, Forcing::EisenstatWalker);     // beyond the seed: measured to win
-  EXPECT_EQ(m.preconditioner, Preconditioner::None);  // GMRES: the tangent is an option
+  EXPECT_EQ(m.forcing, Forcing::EisenstatWalker);       // beyond the seed: measured to win
+  EXPECT_EQ(m.preconditioner, Preconditioner::None);    // GMRES: the tangent is an option
   EXPECT_EQ(m.initial_guess, InitialGuess::Particles);  // the seed's v^k: with GMRES, wins
   const Scene v = parse("type = \"implicit\"\n", {"solver.implicit.formulation=velocity"});
   EXPECT_EQ(v.solver.implicit.krylov, KrylovMethod::CG);
   EXPECT_EQ(v.solver.implicit.preconditioner, Preconditioner::Tangent);  // with CG: wins
-  EXPECT_EQ(v.solver.implicit.initial_guess, InitialGuess::Previous);       // with CG: wins
+  EXPECT_EQ(v.solver.implicit.initial_guess, InitialGuess::Previous);    // with CG: wins
 }
 
 TEST(SceneImplicit, EveryKeyIsRead) {
@@ -187,13 +187,15 @@ velocity = "-0.001 0"
       parse_text(text);
       ADD_FAILURE() << "no InputError for " << extra;
     } catch (const InputError& e) {
-      const std::string line = std::to_string(
-          std::count(text.begin(), text.begin() + text.find(extra), '\n') + 1);
-      EXPECT_EQ(std::string(e.what()), "bar.toml:" + line + ": bodies.puller.slip: " + says) << extra;
+      const std::string line =
+          std::to_string(std::count(text.begin(), text.begin() + text.find(extra), '\n') + 1);
+      EXPECT_EQ(std::string(e.what()), "bar.toml:" + line + ": bodies.puller.slip: " + says)
+          << extra;
     }
   };
-  fails("slip = \"z\"", "expected the axes along which the contact is frictionless, from x y, "
-                        "e.g. \"y\"; got 'z' in \"z\"");
+  fails("slip = \"z\"",
+        "expected the axes along which the contact is frictionless, from x y, "
+        "e.g. \"y\"; got 'z' in \"z\"");
   fails("slip = \"x y\"", "a body that slips along every axis holds nothing; leave one axis out");
   fails("slip = \"\"", "expected at least one axis from x y, e.g. \"y\", or \"none\"");
   // On a deformable body.

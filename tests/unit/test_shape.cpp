@@ -4,7 +4,7 @@
 
 #include <random>
 
-#include "mpm/shape.hpp"
+#include "mpm/grid/shape.hpp"
 
 namespace mpm {
 namespace {
@@ -39,10 +39,10 @@ void check_cell(int samples) {
       xG += xc * G[c].transpose();
     }
     const Vec<D> x = xi * h;
-    EXPECT_NEAR(sumN, 1.0, 1e-14);                   // partition of unity
-    EXPECT_LT(sumG.norm(), 1e-12 * inv_h);           // gradients sum to zero
-    EXPECT_NEAR(phi, a0 + g.dot(x), 1e-13);          // linear field reproduced
-    EXPECT_LT((grad - g).norm(), 1e-11 * g.norm());  // its gradient too
+    EXPECT_NEAR(sumN, 1.0, 1e-14);                       // partition of unity
+    EXPECT_LT(sumG.norm(), 1e-12 * inv_h);               // gradients sum to zero
+    EXPECT_NEAR(phi, a0 + g.dot(x), 1e-13);              // linear field reproduced
+    EXPECT_LT((grad - g).norm(), 1e-11 * g.norm());      // its gradient too
     EXPECT_LT((xG - Mat<D>::Identity()).norm(), 1e-12);  // sum x_c (x) G_c = I
     double Nv[kCorners<D>];
     shape_values<D>(xi, Nv);
@@ -50,8 +50,12 @@ void check_cell(int samples) {
   }
 }
 
-TEST(Shape, Trilinear) { check_cell<3>(2000); }
-TEST(Shape, Bilinear) { check_cell<2>(2000); }
+TEST(Shape, Trilinear) {
+  check_cell<3>(2000);
+}
+TEST(Shape, Bilinear) {
+  check_cell<2>(2000);
+}
 
 TEST(Shape, CornerValuesAreKronecker) {
   for (int k = 0; k < 8; ++k) {

@@ -4,9 +4,9 @@
 
 #include <set>
 
-#include "mpm/grid.hpp"
-#include "mpm/lattice.hpp"
-#include "mpm/sparse_grid.hpp"
+#include "mpm/grid/grid.hpp"
+#include "mpm/grid/lattice.hpp"
+#include "mpm/grid/sparse_grid.hpp"
 
 namespace mpm {
 namespace {

@@ -1,4 +1,4 @@
-// Tests of the stream format (common/mpm/stream.hpp, docs/format.md): round trips through
+// Tests of the stream format (common/mpm/stream/stream.hpp, docs/format.md): round trips through
 // files, FIFOs and stdin/stdout, f32 precision, field selection, and damage: truncation at
 // every byte, a flipped byte anywhere, bad headers, unknown record types, write failures.
 #include <fcntl.h>
@@ -22,8 +22,8 @@
 #include <set>
 #include <thread>
 
-#include "mpm/error.hpp"
-#include "mpm/stream.hpp"
+#include "mpm/core/error.hpp"
+#include "mpm/stream/stream.hpp"
 
 namespace mpm {
 namespace {
@@ -92,13 +92,15 @@ Frame make_frame(std::int64_t step, std::size_t n, std::uint32_t flags = 0) {
   for (std::size_t i = 0; i < n; ++i) {
     for (int k = 0; k < 3; ++k) set(s.at("x"), i, k, b + 1.0 / 3.0 * double(i * 3 + k) + 1e-12);
     for (int k = 0; k < 3; ++k) set(s.at("v"), i, k, -b * 7.1 + std::sqrt(2.0) * double(i + k));
-    for (int k = 0; k < 6; ++k) set(s.at("sigma"), i, k, 1.234567891234e8 * (double(k) - 2.5) + double(i) / 7);
+    for (int k = 0; k < 6; ++k)
+      set(s.at("sigma"), i, k, 1.234567891234e8 * (double(k) - 2.5) + double(i) / 7);
     set(s.at("mass"), i, 0, 1e-9 * (1.0 + double(i) / 11));
     for (int k = 0; k < 2; ++k) set(s.at("normal"), i, k, float(0.3 * double(k + i) - b));
     set(s.at("material"), i, 0, std::uint8_t(200 + i));
     set(s.at("id"), i, 0, std::uint32_t(4000000000u + i));
     for (int k = 0; k < 6; ++k) set(s.at("cell"), i, k, std::int32_t(-1000000 * k + int(i) - 3));
-    for (int k = 0; k < 2; ++k) set(s.at("key"), i, k, (std::uint64_t(1) << 60) + 12345 * i + k + step);
+    for (int k = 0; k < 2; ++k)
+      set(s.at("key"), i, k, (std::uint64_t(1) << 60) + 12345 * i + k + step);
   }
   return f;
 }
@@ -129,7 +131,8 @@ void expect_frame(const Frame& want, const Frame& got, Precision precision = Pre
       const bool narrowed = precision == Precision::Float32 && wi.name != "x";
       for (std::size_t i = 0; i < n; ++i)
         for (int k = 0; k < wi.components; ++k) {
-          double e = wi.type == ScalarType::F32 ? double(get<float>(w, i, k)) : get<double>(w, i, k);
+          double e =
+              wi.type == ScalarType::F32 ? double(get<float>(w, i, k)) : get<double>(w, i, k);
           if (narrowed) e = double(float(e));
           ASSERT_EQ(get<double>(g, i, k), e) << "element " << i << " component " << k;
         }
@@ -146,7 +149,8 @@ HistoryBlock make_history(int rows) {
   HistoryBlock h;
   h.names = {"time", "dt", "kinetic"};
   h.units = {"s", "s", "J"};
-  for (int r = 0; r < rows; ++r) h.values.insert(h.values.end(), {r * 1e-7, 1e-7 / 3, 0.5 * r * r + 1.0 / 7});
+  for (int r = 0; r < rows; ++r)
+    h.values.insert(h.values.end(), {r * 1e-7, 1e-7 / 3, 0.5 * r * r + 1.0 / 7});
   return h;
 }
 
@@ -244,13 +248,16 @@ Bytes make_record(const char fourcc[4], const Bytes& payload, bool good_crc = tr
   const std::uint64_t len = payload.size();
   r.append(reinterpret_cast<const char*>(&len), 8);
   r += payload;
-  std::uint32_t crc = std::uint32_t(crc32(0, reinterpret_cast<const Bytef*>(r.data()), uInt(r.size())));
+  std::uint32_t crc =
+      std::uint32_t(crc32(0, reinterpret_cast<const Bytef*>(r.data()), uInt(r.size())));
   if (!good_crc) crc ^= 1;
   r.append(reinterpret_cast<const char*>(&crc), 4);
   return r;
 }
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
 
 // ---------------------------------------------------------------------------------------------
 
@@ -267,7 +274,10 @@ TEST(Stream, RecordNames) {
 TEST(Stream, HeaderBytes) {
   TempDir d;
   const std::string p = d.file("h.mpm");
-  { StreamWriter w(p); EXPECT_EQ(w.bytes_written(), 16u); }
+  {
+    StreamWriter w(p);
+    EXPECT_EQ(w.bytes_written(), 16u);
+  }
   const Bytes b = slurp(p);
   EXPECT_EQ(b, Bytes("\x89MPM\r\n\x1a\n\x01\x00\x01\x00\x00\x00\x00\x00", 16));  // 1.1
   // A stream with no records reads cleanly, but has not ended.
@@ -330,7 +340,8 @@ TEST(Stream, RoundTripFile) {
   // Not reading the frame: next() skips it.
   ASSERT_TRUE(r.next(type));
   ASSERT_EQ(type, std::uint32_t(RecordType::End));
-  EXPECT_EQ(StreamReader::decode_end(r.read_payload()), std::make_pair(0, std::string("completed")));
+  EXPECT_EQ(StreamReader::decode_end(r.read_payload()),
+            std::make_pair(0, std::string("completed")));
   EXPECT_FALSE(r.next(type));
   EXPECT_FALSE(r.next(type));
   EXPECT_EQ(r.records_read(), 7u);
@@ -341,7 +352,10 @@ TEST(Stream, RoundTripFile) {
 TEST(Stream, VisitorWithoutFrames) {
   TempDir d;
   const std::string p = d.file("run.mpm");
-  { StreamWriter w(p); write_sample(w); }
+  {
+    StreamWriter w(p);
+    write_sample(w);
+  }
   Collected c;
   StreamVisitor v = c.visitor();
   v.want_frames = false;
@@ -374,7 +388,10 @@ TEST(Stream, EndStatusOfAnUnstableRun) {
 TEST(Stream, VisitorExceptionsPropagate) {
   TempDir d;
   const std::string p = d.file("run.mpm");
-  { StreamWriter w(p); write_sample(w); }
+  {
+    StreamWriter w(p);
+    write_sample(w);
+  }
   StreamVisitor v;
   v.frame = [](Frame&&) { throw InputError("post", "no column 'T'"); };
   EXPECT_THROW(read_stream(p, v), InputError);
@@ -384,8 +401,14 @@ TEST(Stream, Float32Precision) {
   TempDir d;
   const std::string p64 = d.file("f64.mpm"), p32 = d.file("f32.mpm");
   const Frame f = make_frame(5, 100);
-  { StreamWriter w(p64); w.write_frame(f); }
-  { StreamWriter w(p32); w.write_frame(f, {}, Precision::Float32); }
+  {
+    StreamWriter w(p64);
+    w.write_frame(f);
+  }
+  {
+    StreamWriter w(p32);
+    w.write_frame(f, {}, Precision::Float32);
+  }
   // v, sigma and mass (10 f64 per element) shrink to f32; x, normal and the integers stay.
   EXPECT_EQ(fs::file_size(p64) - fs::file_size(p32), 100u * 10 * 4);
   Collected c;
@@ -394,8 +417,10 @@ TEST(Stream, Float32Precision) {
   ASSERT_EQ(c.frames.size(), 1u);
   expect_frame(f, c.frames[0], Precision::Float32);
   // f32 rounding is visible, so the test above can tell the precisions apart.
-  EXPECT_NE(get<double>(c.frames[0].columns.at("mass"), 1, 0), get<double>(f.columns.at("mass"), 1, 0));
-  EXPECT_NE(double(float(get<double>(f.columns.at("x"), 1, 2))), get<double>(f.columns.at("x"), 1, 2));
+  EXPECT_NE(get<double>(c.frames[0].columns.at("mass"), 1, 0),
+            get<double>(f.columns.at("mass"), 1, 0));
+  EXPECT_NE(double(float(get<double>(f.columns.at("x"), 1, 2))),
+            get<double>(f.columns.at("x"), 1, 2));
   EXPECT_EQ(get<double>(c.frames[0].columns.at("x"), 1, 2), get<double>(f.columns.at("x"), 1, 2));
   // Out of the f32 range: infinite, not undefined; NaN stays NaN.
   Frame odd;
@@ -403,7 +428,10 @@ TEST(Stream, Float32Precision) {
   odd.columns.resize(4);
   const double in[4] = {1e300, -1e300, std::nan(""), 3.4e38};
   std::memcpy(odd.columns.at("p").data(), in, sizeof in);
-  { StreamWriter w(p32); w.write_frame(odd, {}, Precision::Float32); }
+  {
+    StreamWriter w(p32);
+    w.write_frame(odd, {}, Precision::Float32);
+  }
   Collected co;
   read_stream(p32, co.visitor());
   ASSERT_EQ(co.frames.size(), 1u);
@@ -414,7 +442,10 @@ TEST(Stream, Float32Precision) {
   EXPECT_EQ(out[3], double(3.4e38f));
   // Large frames convert in several chunks.
   const Frame big = make_frame(6, 20000);
-  { StreamWriter w(p32); w.write_frame(big, {"sigma", "x"}, Precision::Float32); }
+  {
+    StreamWriter w(p32);
+    w.write_frame(big, {"sigma", "x"}, Precision::Float32);
+  }
   Collected cb;
   read_stream(p32, cb.visitor());
   ASSERT_EQ(cb.frames.size(), 1u);
@@ -426,7 +457,10 @@ TEST(Stream, FieldSelection) {
   const std::string p = d.file("sel.mpm");
   const Frame f = make_frame(1, 7);
   const std::vector<std::string> fields{"id", "x", "normal"};
-  { StreamWriter w(p); w.write_frame(f, fields); }
+  {
+    StreamWriter w(p);
+    w.write_frame(f, fields);
+  }
   Collected c;
   read_stream(p, c.visitor());
   ASSERT_EQ(c.frames.size(), 1u);
@@ -440,8 +474,9 @@ TEST(Stream, FieldSelection) {
     FAIL() << "unknown field accepted";
   } catch (const InputError& e) {
     EXPECT_EQ(e.where(), "output.fields");
-    EXPECT_EQ(e.message(),
-              "unknown field 'foo' (available: x, v, sigma, mass, normal, material, id, cell, key)");
+    EXPECT_EQ(
+        e.message(),
+        "unknown field 'foo' (available: x, v, sigma, mass, normal, material, id, cell, key)");
   }
   EXPECT_THROW(w.write_frame(f, {"x", "v", "x"}), InputError);
   EXPECT_EQ(w.bytes_written(), before) << "nothing is written for a bad selection";
@@ -499,7 +534,10 @@ TEST(Stream, RoundTripFifo) {
   // Skipping a 3 MB record of a later minor version, then damage, on a pipe.
   std::thread raw([&] {
     Bytes b;
-    { StreamWriter w(d.file("tmp.mpm")); w.write_text(RecordType::Scene, kScene); }
+    {
+      StreamWriter w(d.file("tmp.mpm"));
+      w.write_text(RecordType::Scene, kScene);
+    }
     b = slurp(d.file("tmp.mpm"));
     b += make_record("XTRA", Bytes(3 << 20, '\x5a'));
     b += make_record("INFO", kInfo, false);
@@ -512,8 +550,10 @@ TEST(Stream, RoundTripFifo) {
   raw.join();
   EXPECT_EQ(c2.scenes.size(), 1u);
   EXPECT_TRUE(c2.infos.empty());
-  EXPECT_TRUE(contains(s2.damage, "record 3 (INFO at byte " + std::to_string(16 + 12 + kScene.size() + 4 + 12 + (3 << 20) + 4) +
-                                      ") is corrupted (CRC mismatch); no frame precedes it"))
+  EXPECT_TRUE(
+      contains(s2.damage, "record 3 (INFO at byte " +
+                              std::to_string(16 + 12 + kScene.size() + 4 + 12 + (3 << 20) + 4) +
+                              ") is corrupted (CRC mismatch); no frame precedes it"))
       << s2.damage;
 }
 
@@ -559,7 +599,10 @@ TEST(Stream, TruncationAtEveryByte) {
   TempDir d;
   const std::string full = d.file("full.mpm"), cut = d.file("cut.mpm");
   std::vector<Frame> frames;
-  { StreamWriter w(full); frames = write_sample(w, 2); }
+  {
+    StreamWriter w(full);
+    frames = write_sample(w, 2);
+  }
   const Bytes b = slurp(full);
   const Layout layout(b);
   ASSERT_EQ(layout.records.size(), 7u);
@@ -585,22 +628,26 @@ TEST(Stream, TruncationAtEveryByte) {
       const auto& rec = layout.record_at(n);
       const std::string label = cut + ": stream truncated in record " +
                                 std::to_string(&rec - layout.records.data() + 1) + " (" +
-                                (n - rec.begin < 4 ? "" : record_name(rec.type) + " ") + "at byte " +
-                                std::to_string(rec.begin) + "): expected ";
+                                (n - rec.begin < 4 ? "" : record_name(rec.type) + " ") +
+                                "at byte " + std::to_string(rec.begin) + "): expected ";
       ASSERT_TRUE(contains(s.damage, label)) << s.damage;
-      const std::string intact = want == 0 ? "no frame precedes it"
-                                 : want == 1 ? "the 1 frame before it is intact"
-                                             : "the " + std::to_string(want) + " frames before it are intact";
+      const std::string intact =
+          want == 0   ? "no frame precedes it"
+          : want == 1 ? "the 1 frame before it is intact"
+                      : "the " + std::to_string(want) + " frames before it are intact";
       ASSERT_TRUE(contains(s.damage, "; " + intact)) << s.damage;
       const std::size_t payload = rec.end - rec.begin - 16;
       if (n < rec.begin + 12)
-        EXPECT_TRUE(contains(s.damage, "expected a 12-byte record header, found " + std::to_string(n - rec.begin)));
+        EXPECT_TRUE(contains(
+            s.damage, "expected a 12-byte record header, found " + std::to_string(n - rec.begin)));
       else if (n < rec.begin + 12 + payload)
-        EXPECT_TRUE(contains(s.damage, "expected " + std::to_string(payload) + " payload bytes, found " +
+        EXPECT_TRUE(contains(s.damage, "expected " + std::to_string(payload) +
+                                           " payload bytes, found " +
                                            std::to_string(n - rec.begin - 12)))
             << s.damage;
       else
-        EXPECT_TRUE(contains(s.damage, "expected a 4-byte CRC, found " + std::to_string(n - (rec.end - 4))));
+        EXPECT_TRUE(contains(s.damage,
+                             "expected a 4-byte CRC, found " + std::to_string(n - (rec.end - 4))));
     }
   }
 }
@@ -609,7 +656,10 @@ TEST(Stream, CorruptionOfEveryByte) {
   TempDir d;
   const std::string full = d.file("full.mpm"), bad = d.file("bad.mpm");
   std::vector<Frame> frames;
-  { StreamWriter w(full); frames = write_sample(w, 2); }
+  {
+    StreamWriter w(full);
+    frames = write_sample(w, 2);
+  }
   const Bytes b = slurp(full);
   const Layout layout(b);
   for (unsigned char mask : {0x01, 0x80, 0xFF}) {
@@ -627,13 +677,17 @@ TEST(Stream, CorruptionOfEveryByte) {
       ASSERT_EQ(s.frames, want);
       ASSERT_EQ(c.frames.size(), want);
       for (std::size_t i = 0; i < want; ++i) expect_frame(frames[i], c.frames[i]);
-      const std::string record = "record " + std::to_string(&rec - layout.records.data() + 1) + " (";
+      const std::string record =
+          "record " + std::to_string(&rec - layout.records.data() + 1) + " (";
       ASSERT_TRUE(contains(s.damage, record)) << s.damage;
       const bool in_length = at >= rec.begin + 4 && at < rec.begin + 12;
       // A changed length may look like truncation, except in a frame, whose column table
       // gives its length; anything else is reported as corruption.
-      if (!in_length || rec.type == std::uint32_t(RecordType::Frame)) ASSERT_TRUE(contains(s.damage, ") is corrupted (")) << s.damage;
-      else ASSERT_TRUE(contains(s.damage, ") is corrupted (") || contains(s.damage, "truncated")) << s.damage;
+      if (!in_length || rec.type == std::uint32_t(RecordType::Frame))
+        ASSERT_TRUE(contains(s.damage, ") is corrupted (")) << s.damage;
+      else
+        ASSERT_TRUE(contains(s.damage, ") is corrupted (") || contains(s.damage, "truncated"))
+            << s.damage;
     }
   }
 }
@@ -641,7 +695,10 @@ TEST(Stream, CorruptionOfEveryByte) {
 TEST(Stream, StreamHeaderDamage) {
   TempDir d;
   const std::string full = d.file("full.mpm"), bad = d.file("bad.mpm");
-  { StreamWriter w(full); write_sample(w, 2); }
+  {
+    StreamWriter w(full);
+    write_sample(w, 2);
+  }
   const Bytes b = slurp(full);
   for (std::size_t at = 0; at < 16; ++at) {
     Bytes m = b;
@@ -669,18 +726,22 @@ std::string header_error(const std::string& path) {
 TEST(Stream, BadHeaders) {
   TempDir d;
   const std::string p = d.file("in.mpm");
-  spit(p, Bytes("\x7f" "ELF\x02\x01\x01\x00\x00\x00\x00\x00\x00\x00\x00\x00", 16));
+  spit(p, Bytes("\x7f"
+                "ELF\x02\x01\x01\x00\x00\x00\x00\x00\x00\x00\x00\x00",
+                16));
   EXPECT_EQ(header_error(p), p + ": not an mpm stream (bad magic)");
 
   spit(p, "# Taylor bar\n[scene]\nname = \"taylor\"\n");
-  EXPECT_EQ(header_error(p), p + ": not an mpm stream (bad magic); this looks like a scene file; run mpm-prep on it first");
+  EXPECT_EQ(header_error(p), p + ": not an mpm stream (bad magic); this looks like a scene file; "
+                                 "run mpm-prep on it first");
   spit(p, "[scene]\n");  // shorter than a header
   EXPECT_TRUE(contains(header_error(p), "run mpm-prep on it first"));
   spit(p, "end_time = 1e-5\n");
   EXPECT_TRUE(contains(header_error(p), "run mpm-prep on it first"));
 
   spit(p, Bytes("\x89MPM\n\x1a\n\x01\x00\x00\x00\x00\x00\x00\x00\x00", 16));  // CRLF -> LF
-  EXPECT_TRUE(contains(header_error(p), "bad magic); its line endings were converted")) << header_error(p);
+  EXPECT_TRUE(contains(header_error(p), "bad magic); its line endings were converted"))
+      << header_error(p);
 
   spit(p, "");
   EXPECT_TRUE(contains(header_error(p), "empty input")) << header_error(p);
@@ -703,11 +764,16 @@ TEST(Stream, UnknownRecordTypes) {
   TempDir d;
   const std::string full = d.file("full.mpm"), p = d.file("x.mpm");
   std::vector<Frame> frames;
-  { StreamWriter w(full); frames = write_sample(w, 2); }
+  {
+    StreamWriter w(full);
+    frames = write_sample(w, 2);
+  }
   const Bytes b = slurp(full);
   const Layout layout(b);
   const std::size_t after_first_frame = layout.records[2].end;
-  auto splice = [&](const Bytes& rec) { return b.substr(0, after_first_frame) + rec + b.substr(after_first_frame); };
+  auto splice = [&](const Bytes& rec) {
+    return b.substr(0, after_first_frame) + rec + b.substr(after_first_frame);
+  };
 
   // A valid record of an unknown type is skipped; everything else arrives.
   spit(p, splice(make_record("XTRA", "payload of a later minor version")));
@@ -728,8 +794,10 @@ TEST(Stream, UnknownRecordTypes) {
   // A type code outside [A-Z0-9_] is corruption even with a valid CRC.
   spit(p, splice(make_record("xtra", "payload")));
   s = read_stream(p, {});
-  EXPECT_TRUE(contains(s.damage, "record 4 (?0x61727478 at byte " + std::to_string(after_first_frame) +
-                                     ") is corrupted (invalid record type)")) << s.damage;
+  EXPECT_TRUE(contains(s.damage, "record 4 (?0x61727478 at byte " +
+                                     std::to_string(after_first_frame) +
+                                     ") is corrupted (invalid record type)"))
+      << s.damage;
 
   // An implausible length is corruption at once (not a 16 TB read).
   Bytes huge = make_record("XTRA", "");
@@ -737,17 +805,22 @@ TEST(Stream, UnknownRecordTypes) {
   std::memcpy(huge.data() + 4, &len, 8);
   spit(p, splice(huge));
   s = read_stream(p, {});
-  EXPECT_TRUE(contains(s.damage, "is corrupted (implausible payload length 17592186044417)")) << s.damage;
+  EXPECT_TRUE(contains(s.damage, "is corrupted (implausible payload length 17592186044417)"))
+      << s.damage;
   EXPECT_EQ(s.frames, 1u);
 
   // Malformed payloads with a valid CRC are corruption too.
-  spit(p, splice(make_record("HIST", Bytes("\x01\x00\x00\x00\x01\x00t\x01\x00s\x05\x00\x00\x00\x00\x00\x00\x00", 18))));
+  spit(p, splice(make_record(
+              "HIST",
+              Bytes("\x01\x00\x00\x00\x01\x00t\x01\x00s\x05\x00\x00\x00\x00\x00\x00\x00", 18))));
   s = read_stream(p, {});
   EXPECT_EQ(s.damage, "");  // no history callback: not decoded
   Collected c2;
   s = read_stream(p, c2.visitor());
-  EXPECT_TRUE(contains(s.damage, "record 4 (HIST at byte " + std::to_string(after_first_frame) +
-                                     ") is corrupted (malformed HIST payload: 5 rows of 1 values need 40 bytes, 0 are left)"))
+  EXPECT_TRUE(contains(
+      s.damage,
+      "record 4 (HIST at byte " + std::to_string(after_first_frame) +
+          ") is corrupted (malformed HIST payload: 5 rows of 1 values need 40 bytes, 0 are left)"))
       << s.damage;
   spit(p, splice(make_record("ENDS", "ab")));
   s = read_stream(p, {});
@@ -760,7 +833,10 @@ TEST(Stream, FrameTableChecks) {
   // holds an unknown scalar type, are corruption; a huge element count allocates nothing.
   TempDir d;
   const std::string full = d.file("full.mpm"), p = d.file("f.mpm");
-  { StreamWriter w(full); w.write_frame(make_frame(3, 2)); }
+  {
+    StreamWriter w(full);
+    w.write_frame(make_frame(3, 2));
+  }
   const Bytes b = slurp(full);
   const Layout layout(b);
   const Bytes payload = b.substr(16 + 12, layout.records[0].end - 16 - 16);
@@ -780,13 +856,17 @@ TEST(Stream, FrameTableChecks) {
   expect_frame(make_frame(3, 2), ok.frames[0]);
 
   const std::uint64_t n1 = 1, n3 = 3, huge = std::uint64_t(1) << 62;
-  EXPECT_EQ(with(20, &n1, 8), p + ": record 1 (FRAM at byte 16) is corrupted (its length " +
-                                  std::to_string(payload.size()) + " disagrees with its column table (" +
-                                  std::to_string(payload.size() - 157) + " bytes)); no frame precedes it");
-  EXPECT_TRUE(contains(with(20, &n3, 8), "is corrupted (its column table needs more bytes than its length of "));
-  EXPECT_TRUE(contains(with(20, &huge, 8), "is corrupted (its column table needs more bytes than its length of "));
+  EXPECT_EQ(with(20, &n1, 8),
+            p + ": record 1 (FRAM at byte 16) is corrupted (its length " +
+                std::to_string(payload.size()) + " disagrees with its column table (" +
+                std::to_string(payload.size() - 157) + " bytes)); no frame precedes it");
+  EXPECT_TRUE(contains(with(20, &n3, 8),
+                       "is corrupted (its column table needs more bytes than its length of "));
+  EXPECT_TRUE(contains(with(20, &huge, 8),
+                       "is corrupted (its column table needs more bytes than its length of "));
   const std::uint8_t bad_type = 9;  // the type code of "x": after 32 fixed bytes, u16 1, "x"
-  EXPECT_TRUE(contains(with(32 + 3, &bad_type, 1), "is corrupted (column 1 has unknown scalar type 9)"));
+  EXPECT_TRUE(
+      contains(with(32 + 3, &bad_type, 1), "is corrupted (column 1 has unknown scalar type 9)"));
   const std::uint8_t zero = 0;
   EXPECT_TRUE(contains(with(32 + 4, &zero, 1), "is corrupted (column 'x' has 0 components)"));
   const std::uint32_t many = 1000000;
@@ -794,13 +874,17 @@ TEST(Stream, FrameTableChecks) {
   spit(p, b.substr(0, 16) + make_record("FRAM", payload.substr(0, 20)));
   StreamVisitor frames_only;
   frames_only.frame = [](Frame&&) {};
-  EXPECT_TRUE(contains(read_stream(p, frames_only).damage, "is corrupted (a frame needs at least 32 bytes, it has 20)"));
+  EXPECT_TRUE(contains(read_stream(p, frames_only).damage,
+                       "is corrupted (a frame needs at least 32 bytes, it has 20)"));
 }
 
 TEST(Stream, ReaderStaysFailed) {
   TempDir d;
   const std::string full = d.file("full.mpm");
-  { StreamWriter w(full); write_sample(w, 2); }
+  {
+    StreamWriter w(full);
+    write_sample(w, 2);
+  }
   Bytes b = slurp(full);
   const Layout layout(b);
   b[layout.records[0].begin + 14] ^= 1;  // in the SCEN payload
@@ -812,7 +896,9 @@ TEST(Stream, ReaderStaysFailed) {
     r.read_payload();
     FAIL() << "corruption not detected";
   } catch (const StreamError& e) {
-    EXPECT_EQ(std::string(e.what()), full + ": record 1 (SCEN at byte 16) is corrupted (CRC mismatch); no frame precedes it");
+    EXPECT_EQ(
+        std::string(e.what()),
+        full + ": record 1 (SCEN at byte 16) is corrupted (CRC mismatch); no frame precedes it");
   }
   EXPECT_THROW(r.next(type), StreamError);
 }

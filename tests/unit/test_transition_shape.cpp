@@ -6,7 +6,7 @@
 
 #include <random>
 
-#include "mpm/transition_shape.hpp"
+#include "mpm/grid/transition_shape.hpp"
 
 namespace mpm {
 namespace {
@@ -147,8 +147,8 @@ TEST(TransitionShape, MatchesTheSeedsWorkedExamples) {
     const double x = 2 * xi[0] - 1, y = 2 * xi[1] - 1, z = 2 * xi[2] - 1;
     double N[26];
     ASSERT_EQ(transition_shape<3>(mask, xi, 1.0, N, nullptr), 10);
-    const double N25 = 0.5 * (1 - std::abs(x)) * (1 - std::abs(y)) * (1 + z);      // eq. 20
-    const double N10 = 0.25 * (1 - x) * (1 - std::abs(y)) * (1 + z) - 0.5 * N25;  // eq. 21
+    const double N25 = 0.5 * (1 - std::abs(x)) * (1 - std::abs(y)) * (1 + z);        // eq. 20
+    const double N10 = 0.25 * (1 - x) * (1 - std::abs(y)) * (1 + z) - 0.5 * N25;     // eq. 21
     const double N3 = 0.125 * (1 - x) * (1 - y) * (1 + z) - 0.5 * N10 - 0.25 * N25;  // eq. 22
     EXPECT_NEAR(N[8], N10, 1e-15);
     EXPECT_NEAR(N[9], N25, 1e-15);

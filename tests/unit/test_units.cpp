@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "mpm/units.hpp"
+#include "mpm/core/units.hpp"
 
 namespace mpm {
 namespace {

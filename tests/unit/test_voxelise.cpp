@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "mpm/error.hpp"
-#include "mpm/lattice.hpp"
-#include "mpm/voxelise.hpp"
+#include "mpm/core/error.hpp"
+#include "mpm/grid/lattice.hpp"
+#include "mpm/prep/voxelise.hpp"
 
 namespace fs = std::filesystem;
 using namespace mpm;
@@ -154,14 +154,16 @@ std::string input_error_of(F&& f) {
 
 Mat3 rotation(const Vec3& deg) {
   const double k = kPi / 180;
-  return (Eigen::AngleAxisd(k * deg.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(k * deg.y(), Vec3::UnitY()) *
+  return (Eigen::AngleAxisd(k * deg.z(), Vec3::UnitZ()) *
+          Eigen::AngleAxisd(k * deg.y(), Vec3::UnitY()) *
           Eigen::AngleAxisd(k * deg.x(), Vec3::UnitX()))
       .toRotationMatrix();
 }
 
 /// Local-frame coordinates of a world point for a body: S^-1 R^T (x - t).
 Vec3 to_local(const BodySpec& b, const Vec3& x) {
-  return b.scale.cwiseInverse().asDiagonal() * (rotation(b.rotate_deg).transpose() * (x - b.translate));
+  return b.scale.cwiseInverse().asDiagonal() *
+         (rotation(b.rotate_deg).transpose() * (x - b.translate));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -249,12 +251,12 @@ struct TriMesh {
 TriMesh icosphere(double r, int levels) {
   const double t = (1 + std::sqrt(5.0)) / 2;
   TriMesh m;
-  m.v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-         {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  m.v = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+         {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
   for (auto& p : m.v) p.normalize();
-  m.f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+  m.f = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
          {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-         {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+         {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   for (int l = 0; l < levels; ++l) {
     std::map<std::pair<int, int>, int> mid;
     const auto midpoint = [&](int a, int b) {
@@ -309,7 +311,8 @@ TriMesh box_mesh(const Vec3& size) {
   const Vec3 h = size / 2;
   for (int k = 0; k < 8; ++k)
     m.v.push_back({(k & 1) ? h.x() : -h.x(), (k & 2) ? h.y() : -h.y(), (k & 4) ? h.z() : -h.z()});
-  const int q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {1, 3, 7, 5}, {0, 4, 6, 2}};
+  const int q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                       {2, 6, 7, 3}, {1, 3, 7, 5}, {0, 4, 6, 2}};
   for (auto& f : q) {
     m.f.push_back({f[0], f[1], f[2]});
     m.f.push_back({f[0], f[2], f[3]});
@@ -319,7 +322,8 @@ TriMesh box_mesh(const Vec3& size) {
 }
 
 /// Writes a mesh in all four formats; returns the paths.
-std::vector<fs::path> write_all_formats(const TriMesh& m, const fs::path& dir, const std::string& stem) {
+std::vector<fs::path> write_all_formats(const TriMesh& m, const fs::path& dir,
+                                        const std::string& stem) {
   std::vector<fs::path> paths = {dir / (stem + "_ascii.stl"), dir / (stem + "_binary.stl"),
                                  dir / (stem + ".off"), dir / (stem + ".obj")};
   m.write_ascii_stl(paths[0]);
@@ -379,7 +383,8 @@ TEST(MakeLattice, FittedDomainIsTheBodiesBoxPlusPadding) {
   Scene s = make_scene(3, 0.1, Vec3::Zero(), Vec3::Zero());
   s.grid.domain_given = false;
   s.grid.padding = 0.2;
-  s.bodies = {sphere("ball", 0.5, Vec3(1, 2, 3)), box("plate", Vec3(0.4, 0.2, 0.1), Vec3(2.0, 2, 3))};
+  s.bodies = {sphere("ball", 0.5, Vec3(1, 2, 3)),
+              box("plate", Vec3(0.4, 0.2, 0.1), Vec3(2.0, 2, 3))};
   const Lattice lat = make_lattice(s);
   // x from 0.5 - 0.2 to 2.2 + 0.2; y from 1.5 - 0.2 to 2.5 + 0.2; z likewise.
   EXPECT_NEAR(lat.origin.x(), 0.3, 1e-12);
@@ -499,7 +504,8 @@ TEST(Voxelise, OutputIsInLatticeOrder) {
     }
     return k;
   };
-  for (std::size_t p = 1; p < r.store.size(); ++p) ASSERT_LT(key(p - 1), key(p)) << "particle " << p;
+  for (std::size_t p = 1; p < r.store.size(); ++p)
+    ASSERT_LT(key(p - 1), key(p)) << "particle " << p;
 }
 
 TEST(Voxelise, SphereAndCylinderVolumesWithinOnePercent) {
@@ -778,7 +784,8 @@ TEST(Voxelise, AxisymmetricExactMassOfBodiesCrossingTheAxis) {
   r = exact(sphere("cut", 0.2, Vec3(0.05, 0, 0)));
   const double q = 0.04 - 0.0025;
   EXPECT_NEAR(r.exact_mass,
-              rho * (0.05 * (0.04 * (kPi / 2 + std::asin(0.25)) + 0.05 * std::sqrt(q)) + 2.0 / 3.0 * std::pow(q, 1.5)),
+              rho * (0.05 * (0.04 * (kPi / 2 + std::asin(0.25)) + 0.05 * std::sqrt(q)) +
+                     2.0 / 3.0 * std::pow(q, 1.5)),
               1e-12);
   EXPECT_NEAR(r.mass / r.exact_mass, 1.0, 0.01);
   // An ellipse (the disk scaled by 2 along x) centred on the axis: an oblate spheroid, 4/3 pi
@@ -836,7 +843,8 @@ TEST(Voxelise, BodyOutsideTheDomainOrTooThinIsRefused) {
 TEST(Voxelise, RefusesBadShapesAndTooManyBodies) {
   Scene s = make_scene(3, 0.1, Vec3::Zero(), Vec3::Ones());
   s.bodies = {box("flat", Vec3(0.2, 0, 0.2), Vec3(0.5, 0.5, 0.5))};
-  EXPECT_NE(input_error_of([&] { run(s); }).find("scene.toml:10: bodies.flat.size"), std::string::npos);
+  EXPECT_NE(input_error_of([&] { run(s); }).find("scene.toml:10: bodies.flat.size"),
+            std::string::npos);
   s.bodies = {sphere("dot", 0, Vec3(0.5, 0.5, 0.5))};
   EXPECT_NE(input_error_of([&] { run(s); }).find("bodies.dot.radius"), std::string::npos);
   BodySpec c = cylinder("stub", 0.1, -1);
@@ -991,10 +999,9 @@ TEST_F(VoxeliseMesh, BoxMeshGivesExactlyTheBoxPrimitiveParticles) {
   // A binary STL whose header starts with "solid " (read as ASCII first, then as binary).
   const fs::path solid_binary = dir_ / "unitbox_solid_header.stl";
   box_mesh(Vec3::Ones()).write_binary_stl(solid_binary, "solid exported by a CAD tool");
-  std::vector<std::string> files = {paths[0].string(),    paths[1].string(),
-                                    paths[2].string(),    paths[3].string(),
-                                    solid_binary.string(), kData + "box_12.stl",
-                                    kData + "cube_quads.obj"};
+  std::vector<std::string> files = {
+      paths[0].string(),     paths[1].string(),    paths[2].string(),       paths[3].string(),
+      solid_binary.string(), kData + "box_12.stl", kData + "cube_quads.obj"};
   for (const auto& f : files) {
     SCOPED_TRACE(f);
     BodySpec m = mesh_body("brick", f);
@@ -1123,9 +1130,10 @@ TEST_F(VoxeliseMesh, LongSpeed) {
     t0 = clock::now();
     st = voxelise(s, lm, rep);
     dt = std::chrono::duration<double>(clock::now() - t0).count();
-    std::printf("icosphere mesh: %zu particles in %.3f s = %.3g particles/s (includes reading "
-                "and checking the mesh, %.3f s)\n",
-                st.size(), dt, st.size() / dt, t_read);
+    std::printf(
+        "icosphere mesh: %zu particles in %.3f s = %.3g particles/s (includes reading "
+        "and checking the mesh, %.3f s)\n",
+        st.size(), dt, st.size() / dt, t_read);
     EXPECT_LT(dt, 60.0);
   }
 }

@@ -2,19 +2,6 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <map>
-#include <set>
-#include <string>
-#include <thread>
-#include <vector>
-
 #include <vtkDataArray.h>
 #include <vtkFieldData.h>
 #include <vtkImageData.h>
@@ -29,9 +16,21 @@
 #include <vtkXMLDataParser.h>
 #include <vtkXMLUnstructuredGridReader.h>
 
-#include "mpm/error.hpp"
-#include "mpm/types.hpp"
-#include "mpm/vtk/vtk_output.hpp"
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "mpm/core/error.hpp"
+#include "mpm/core/types.hpp"
+#include "mpm/post/vtk/vtk_output.hpp"
 
 namespace fs = std::filesystem;
 using namespace mpm;
@@ -45,12 +44,16 @@ struct ScopedEnv {
   std::string old;
   ScopedEnv(const char* n, const char* value) : name(n) {
     if (const char* v = std::getenv(n)) had = true, old = v;
-    if (value) ::setenv(n, value, 1);
-    else ::unsetenv(n);
+    if (value)
+      ::setenv(n, value, 1);
+    else
+      ::unsetenv(n);
   }
   ~ScopedEnv() {
-    if (had) ::setenv(name.c_str(), old.c_str(), 1);
-    else ::unsetenv(name.c_str());
+    if (had)
+      ::setenv(name.c_str(), old.c_str(), 1);
+    else
+      ::unsetenv(name.c_str());
   }
 };
 
@@ -164,8 +167,8 @@ void check_vtu(const Frame& f, int dim, vtkUnstructuredGrid* g) {
   vtkPointData* pd = g->GetPointData();
   std::set<std::string> names;
   for (int a = 0; a < pd->GetNumberOfArrays(); ++a) names.insert(pd->GetArrayName(a));
-  std::set<std::string> expected = {"id",    "body", "material", "v",         "m",
-                                    "rho",   "sigma", "e",       "eps_p",     "T",
+  std::set<std::string> expected = {"id",     "body",      "material", "v",         "m",
+                                    "rho",    "sigma",     "e",        "eps_p",     "T",
                                     "failed", "extra_i32", "pressure", "von_mises", "speed"};
   EXPECT_EQ(names, expected);
 
@@ -200,11 +203,20 @@ void check_vtu(const Frame& f, int dim, vtkUnstructuredGrid* g) {
         double want = 0;
         if (k < nc) {
           switch (info.type) {
-            case ScalarType::F64: want = reinterpret_cast<const double*>(c.data())[i * nc + k]; break;
-            case ScalarType::U8: want = reinterpret_cast<const std::uint8_t*>(c.data())[i * nc + k]; break;
-            case ScalarType::U32: want = reinterpret_cast<const std::uint32_t*>(c.data())[i * nc + k]; break;
-            case ScalarType::I32: want = reinterpret_cast<const std::int32_t*>(c.data())[i * nc + k]; break;
-            default: FAIL() << "unexpected type";
+            case ScalarType::F64:
+              want = reinterpret_cast<const double*>(c.data())[i * nc + k];
+              break;
+            case ScalarType::U8:
+              want = reinterpret_cast<const std::uint8_t*>(c.data())[i * nc + k];
+              break;
+            case ScalarType::U32:
+              want = reinterpret_cast<const std::uint32_t*>(c.data())[i * nc + k];
+              break;
+            case ScalarType::I32:
+              want = reinterpret_cast<const std::int32_t*>(c.data())[i * nc + k];
+              break;
+            default:
+              FAIL() << "unexpected type";
           }
         }
         ASSERT_EQ(a->GetComponent(vtkIdType(i), k), want) << i << " " << k;
@@ -223,9 +235,10 @@ void check_vtu(const Frame& f, int dim, vtkUnstructuredGrid* g) {
   for (std::size_t i = 0; i < n; ++i) {
     const Sym s = sigma_of(i);
     const double pr = -(s[0] + s[1] + s[2]) / 3.0;
-    const double vme = std::sqrt(0.5 * ((s[0] - s[1]) * (s[0] - s[1]) + (s[1] - s[2]) * (s[1] - s[2]) +
-                                        (s[2] - s[0]) * (s[2] - s[0])) +
-                                 3.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]));
+    const double vme =
+        std::sqrt(0.5 * ((s[0] - s[1]) * (s[0] - s[1]) + (s[1] - s[2]) * (s[1] - s[2]) +
+                         (s[2] - s[0]) * (s[2] - s[0])) +
+                  3.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]));
     ASSERT_NEAR(p->GetTuple1(vtkIdType(i)), pr, 1e-9 * std::abs(pr) + 1e-6);
     ASSERT_NEAR(vm->GetTuple1(vtkIdType(i)), vme, 1e-9 * vme);
     double s2 = 0;
@@ -256,7 +269,8 @@ TEST(Vtk, WritesVtu3DWithEveryColumn) {
   const std::string head((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(head.find("compressor=\"vtkZLibDataCompressor\""), std::string::npos);
   EXPECT_NE(head.find("format=\"appended\""), std::string::npos);
-  EXPECT_NE(head.find("<AppendedData encoding=\"raw\""), std::string::npos) << "AppendedData should be raw";
+  EXPECT_NE(head.find("<AppendedData encoding=\"raw\""), std::string::npos)
+      << "AppendedData should be raw";
   auto g = read_vtu(path);
   check_vtu(f, 3, g);
 }
@@ -353,7 +367,8 @@ TEST(Vtk, PvdEscapesFileNames) {
   const std::string pvd = dir / "odd.pvd";
   parser->SetFileName(pvd.c_str());
   ASSERT_EQ(parser->Parse(), 1);
-  vtkXMLDataElement* ds = parser->GetRootElement()->FindNestedElementWithName("Collection")->GetNestedElement(0);
+  vtkXMLDataElement* ds =
+      parser->GetRootElement()->FindNestedElementWithName("Collection")->GetNestedElement(0);
   EXPECT_EQ(std::string(ds->GetAttribute("file")), "a&b <\"c\">.vtu");
 }
 
@@ -489,7 +504,9 @@ void check_picture(const Picture& p, int width, int height) {
   EXPECT_GT(double(p.count_near(255, 255, 255, 0)) / total, 0.2);
   // Particles: many distinct colours from the colour map and the sphere shading.
   EXPECT_GT(p.colours.size(), 200u);
-  EXPECT_GT(double(p.count_if([](int r, int g, int b) { return std::abs(r - g) + std::abs(g - b) > 60; })) / total,
+  EXPECT_GT(double(p.count_if(
+                [](int r, int g, int b) { return std::abs(r - g) + std::abs(g - b) > 60; })) /
+                total,
             0.05);
   // The colour bar shows both ends of viridis (dark purple 68,1,84 and yellow 253,231,37).
   EXPECT_GT(p.count_near(68, 1, 84, 12), 20u);
@@ -567,7 +584,8 @@ TEST(VtkRender, LongMillionParticles) {
   auto t0 = std::chrono::steady_clock::now();
   write_vtu(f, 3, dir / "million.vtu");
   auto t1 = std::chrono::steady_clock::now();
-  std::printf("write_vtu: 1e6 particles in %.2f s, %.1f MB\n", std::chrono::duration<double>(t1 - t0).count(),
+  std::printf("write_vtu: 1e6 particles in %.2f s, %.1f MB\n",
+              std::chrono::duration<double>(t1 - t0).count(),
               double(fs::file_size(dir / "million.vtu")) / 1e6);
   const int status = run_render_child(dir.path.string(), 1000000);
   if (status == 77) GTEST_SKIP() << "no xvfb-run on this machine";
@@ -606,7 +624,8 @@ TEST(Vtk, EnsureDisplayReturnsWithADisplayAndRefusesALoop) {
       ensure_display(1, argv);
       FAIL() << "no exception";
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("no display and no xvfb-run"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("no display and no xvfb-run"), std::string::npos)
+          << e.what();
     }
     EXPECT_EQ(std::getenv("MPM_UNDER_XVFB"), nullptr);
   }

@@ -2,10 +2,10 @@
 // Scenes and particle blocks built in code for the solver tests (no parser, no voxeliser).
 #include <functional>
 
-#include "mpm/columns.hpp"
-#include "mpm/lattice.hpp"
-#include "mpm/particles.hpp"
-#include "mpm/scene.hpp"
+#include "mpm/core/columns.hpp"
+#include "mpm/grid/lattice.hpp"
+#include "mpm/scene/particles.hpp"
+#include "mpm/scene/scene.hpp"
 
 namespace mpm::testing {
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "fixtures.hpp"
-#include "mpm/explicit_solver.hpp"
+#include "mpm/solver/explicit/explicit_solver.hpp"
 
 namespace mpm {
 namespace {
@@ -27,8 +27,9 @@ void conservation(Scheme scheme) {
   const Lattice lat = lattice(D, Vec3::Zero(), h, {12, 12, D == 3 ? 12 : 1});
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);
-  ColumnStore cols = block<D>(lat, IVec<D>::Constant(3), IVec<D>::Constant(8), 2, 2700,
-                              [&](const Vec<D>&) { return Vec<D>(Vec<D>::NullaryExpr([&] { return 10 * u(rng); })); });
+  ColumnStore cols = block<D>(
+      lat, IVec<D>::Constant(3), IVec<D>::Constant(8), 2, 2700,
+      [&](const Vec<D>&) { return Vec<D>(Vec<D>::NullaryExpr([&] { return 10 * u(rng); })); });
   // Jitter positions inside their cells and give every particle a random stress.
   prepare_columns(cols, s);
   auto p = view<D>(cols);
@@ -109,8 +110,8 @@ TEST(Explicit, UslSmallMassInstabilityIsStoppedByTheEnergyGuard) {
   s.solver.scheme = Scheme::USL;
   const Lattice lat = lattice(3, Vec3::Zero(), h, {30, 20, 20});
   const Vec3 v0(150.0, -40.0, 25.0);
-  ColumnStore cols = block<3>(lat, IVec<3>(3, 5, 5), IVec<3>(9, 11, 11), 2, 7800,
-                              [&](const Vec3&) { return v0; });
+  ColumnStore cols =
+      block<3>(lat, IVec<3>(3, 5, 5), IVec<3>(9, 11, 11), 2, 7800, [&](const Vec3&) { return v0; });
   UniformSolver<3> solver(s, UniformGrid<3>(lat, s.boundary), cols);
   try {
     while (solver.time() < 40e-6) solver.step(solver.stable_dt());
@@ -133,8 +134,11 @@ double spin_stress(int refine, double& angular_error) {
   Scene s = scene_with(elastic(E, 0.3, rho), 3, h, 1.0);
   const Lattice lat = lattice(3, Vec3::Zero(), h, {24 * refine, 24 * refine, 12 * refine});
   const Vec3 centre(12e-3, 12e-3, 6e-3);
-  auto spin = [&](const Vec3& x) { return Vec3(-w * (x[1] - centre[1]), w * (x[0] - centre[0]), 0.0); };
-  ColumnStore cols = block<3>(lat, IVec<3>(7, 7, 3) * refine, IVec<3>(17, 17, 9) * refine, 2, rho, spin);
+  auto spin = [&](const Vec3& x) {
+    return Vec3(-w * (x[1] - centre[1]), w * (x[0] - centre[0]), 0.0);
+  };
+  ColumnStore cols =
+      block<3>(lat, IVec<3>(7, 7, 3) * refine, IVec<3>(17, 17, 9) * refine, 2, rho, spin);
   auto angular = [&](ColumnStore& c) {
     auto p = view<3>(c);
     double Lz = 0;
@@ -223,11 +227,11 @@ double vibration(Scheme scheme, int cells, double& drift_4_periods) {
   Scene s = scene_with(elastic(E, 0.0, rho), 3, h, 1.0);
   s.solver.scheme = scheme;
   s.boundary.face = {BoundaryType::Fixed, BoundaryType::Fixed, BoundaryType::Slip,
-                     BoundaryType::Slip, BoundaryType::Slip, BoundaryType::Slip};
+                     BoundaryType::Slip,  BoundaryType::Slip,  BoundaryType::Slip};
   const Lattice lat = lattice(3, Vec3::Zero(), h, {cells, 1, 1});
-  ColumnStore cols = block<3>(lat, IVec<3>(0, 0, 0), IVec<3>(cells, 1, 1), 2, rho, [&](const Vec3& x) {
-    return Vec3(v0 * std::sin(M_PI * x[0] / Lbar), 0, 0);
-  });
+  ColumnStore cols =
+      block<3>(lat, IVec<3>(0, 0, 0), IVec<3>(cells, 1, 1), 2, rho,
+               [&](const Vec3& x) { return Vec3(v0 * std::sin(M_PI * x[0] / Lbar), 0, 0); });
   UniformSolver<3> solver(s, UniformGrid<3>(lat, s.boundary), cols);
   const double E0 = solver.balance().total();
   const double period = 2 * Lbar / c;
@@ -268,9 +272,9 @@ double strip_speed(bool plane_stress, double nu, double& drift) {
   s.boundary.face = {BoundaryType::Slip, BoundaryType::Slip, BoundaryType::Free,
                      BoundaryType::Free, BoundaryType::Free, BoundaryType::Free};
   const Lattice lat = lattice(2, Vec3::Zero(), h, {int(cells), 6, 1});
-  ColumnStore cols = block<2>(lat, IVec<2>(0, 2), IVec<2>(int(cells), 4), 2, rho, [&](const Vec<2>& x) {
-    return Vec<2>(v0 * std::sin(M_PI * x[0] / Lbar), 0);
-  });
+  ColumnStore cols =
+      block<2>(lat, IVec<2>(0, 2), IVec<2>(int(cells), 4), 2, rho,
+               [&](const Vec<2>& x) { return Vec<2>(v0 * std::sin(M_PI * x[0] / Lbar), 0); });
   UniformSolver<2> solver(s, UniformGrid<2>(lat, s.boundary), cols);
   const double E0 = solver.balance().total();
   // Four whole periods of the expected speed: the total energy swings within a period (the

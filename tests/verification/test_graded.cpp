@@ -7,7 +7,7 @@
 #include <cstring>
 
 #include "fixtures.hpp"
-#include "mpm/graded_solver.hpp"
+#include "mpm/solver/explicit/graded_solver.hpp"
 
 namespace mpm {
 namespace {
@@ -107,8 +107,12 @@ void split_conserves() {
   EXPECT_GT(fine, 0);
 }
 
-TEST(GradedSplit, ConservesMassMomentumAndEnergyExactly3D) { split_conserves<3>(); }
-TEST(GradedSplit, ConservesMassMomentumAndEnergyExactly2D) { split_conserves<2>(); }
+TEST(GradedSplit, ConservesMassMomentumAndEnergyExactly3D) {
+  split_conserves<3>();
+}
+TEST(GradedSplit, ConservesMassMomentumAndEnergyExactly2D) {
+  split_conserves<2>();
+}
 
 // One coarse particle at rest inside a level-2 box splits into 2^D children at the centres of
 // the 2^D parts of its extent (004, eq. 23: L = L0 (1 + eps), eps = 0 here), each with an
@@ -151,8 +155,12 @@ void split_geometry() {
   for (std::size_t i = 1; i < p.n; ++i) EXPECT_EQ(p.id[i], std::uint32_t(i));
 }
 
-TEST(GradedSplit, ChildrenFillTheParentsExtent3D) { split_geometry<3>(); }
-TEST(GradedSplit, ChildrenFillTheParentsExtent2D) { split_geometry<2>(); }
+TEST(GradedSplit, ChildrenFillTheParentsExtent3D) {
+  split_geometry<3>();
+}
+TEST(GradedSplit, ChildrenFillTheParentsExtent2D) {
+  split_geometry<2>();
+}
 
 // A free elastic bar crossing a level-2 box, pulled at one end by a constant force F: its
 // momentum grows by F t exactly (the load is the only external force; the transition shape
@@ -184,8 +192,12 @@ void load_impulse() {
   EXPECT_GT(solver.splits(), 0);  // the coarse particles in the box split in the first step
 }
 
-TEST(GradedLoads, ImpulseEqualsMomentumThroughTransitionCells3D) { load_impulse<3>(); }
-TEST(GradedLoads, ImpulseEqualsMomentumThroughTransitionCells2D) { load_impulse<2>(); }
+TEST(GradedLoads, ImpulseEqualsMomentumThroughTransitionCells3D) {
+  load_impulse<3>();
+}
+TEST(GradedLoads, ImpulseEqualsMomentumThroughTransitionCells2D) {
+  load_impulse<2>();
+}
 
 // A compression pulse crossing two level interfaces of a 2D bar: the energy central
 // differences conserve (kinetic at the half steps plus internal) stays within 1% of the

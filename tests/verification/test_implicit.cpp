@@ -10,8 +10,8 @@
 #include <random>
 
 #include "fixtures.hpp"
-#include "mpm/explicit_solver.hpp"
-#include "mpm/implicit/implicit_solver.hpp"
+#include "mpm/solver/explicit/explicit_solver.hpp"
+#include "mpm/solver/implicit/implicit_solver.hpp"
 
 namespace mpm {
 namespace {
@@ -134,10 +134,11 @@ TEST(Implicit, MatrixFreeProductMatchesFiniteDifferenceJacobian) {
 // The tangent preconditioner (preconditioner = "tangent") on a linear elastic step is the
 // Jacobian's inverse: P^-1 J = I up to what the assembled tangent leaves out, the geometric
 // terms of the step (its strain increments are about 1% here: measured 3e-3 to 6e-3, so 1e-2)
-// and, with stress, the stress's own stiffness (sigma / E ~ 1e-3). J is the central-difference Jacobian of the step's residual; P^-1 applied
-// to its columns. Velocity formulation: P^-1 = scale (M + dt^2 K)^-1, symmetric positive
-// definite (CG); momentum: P^-1 = scale (I + dt^2 K M^-1 M_c M^-1)^-1, the remap of eq. 3.2.7
-// included. At the explicit step (dt^2 K < M) the diagonal stands in for it.
+// and, with stress, the stress's own stiffness (sigma / E ~ 1e-3). J is the central-difference
+// Jacobian of the step's residual; P^-1 applied to its columns. Velocity formulation: P^-1 = scale
+// (M + dt^2 K)^-1, symmetric positive definite (CG); momentum: P^-1 = scale (I + dt^2 K M^-1 M_c
+// M^-1)^-1, the remap of eq. 3.2.7 included. At the explicit step (dt^2 K < M) the diagonal stands
+// in for it.
 TEST(Implicit, TangentPreconditionerInvertsTheJacobianOfALinearElasticStep) {
   for (Formulation f : {Formulation::Velocity, Formulation::Momentum}) {
     SCOPED_TRACE(f == Formulation::Velocity ? "velocity" : "momentum");
@@ -164,11 +165,13 @@ TEST(Implicit, TangentPreconditionerInvertsTheJacobianOfALinearElasticStep) {
       const double err = (PJ - Eigen::MatrixXd::Identity(n, n)).norm() / std::sqrt(double(n));
       EXPECT_LT(err, 1e-2) << "stressed " << stressed;
       // Without it the same Jacobian is far from the identity: the test can fail.
-      const double plain = (J * (1.0 / J.diagonal().mean()) - Eigen::MatrixXd::Identity(n, n)).norm() /
-                           std::sqrt(double(n));
+      const double plain =
+          (J * (1.0 / J.diagonal().mean()) - Eigen::MatrixXd::Identity(n, n)).norm() /
+          std::sqrt(double(n));
       EXPECT_GT(plain, 0.5);
-      std::printf("tangent preconditioner, %s, stressed %d: |P^-1 J - I| / sqrt(n) = %.2e (plain %.2f)\n",
-                  f == Formulation::Velocity ? "velocity" : "momentum", stressed, err, plain);
+      std::printf(
+          "tangent preconditioner, %s, stressed %d: |P^-1 J - I| / sqrt(n) = %.2e (plain %.2f)\n",
+          f == Formulation::Velocity ? "velocity" : "momentum", stressed, err, plain);
     }
     // At the explicit step the stiffness does not outweigh the mass: the diagonal (velocity)
     // or nothing (momentum) is used.

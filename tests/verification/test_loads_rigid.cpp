@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "fixtures.hpp"
-#include "mpm/explicit_solver.hpp"
+#include "mpm/solver/explicit/explicit_solver.hpp"
 
 namespace mpm {
 namespace {
@@ -26,11 +26,15 @@ void load_impulse() {
   load.region_max = Vec3(9e-3, 1, 1);
   s.loads.push_back(load);
   const Lattice lat = lattice(D, Vec3::Zero(), h, {16, 8, D == 3 ? 8 : 1});
-  ColumnStore cols = block<D>(lat, IVec<D>::Constant(2), IVec<D>::Constant(2) + [] {
-    IVec<D> n = IVec<D>::Constant(2);
-    n[0] = 7;
-    return n;
-  }(), 2, 2700, [](const Vec<D>&) { return Vec<D>::Zero(); });
+  ColumnStore cols = block<D>(
+      lat, IVec<D>::Constant(2),
+      IVec<D>::Constant(2) +
+          [] {
+            IVec<D> n = IVec<D>::Constant(2);
+            n[0] = 7;
+            return n;
+          }(),
+      2, 2700, [](const Vec<D>&) { return Vec<D>::Zero(); });
   UniformSolver<D> solver(s, UniformGrid<D>(lat, s.boundary), cols);
   while (solver.time() < 2e-6) solver.step(std::min(solver.stable_dt(), 2e-6 - solver.time()));
   const Vec3 expect = load.force * solver.time();
@@ -44,8 +48,12 @@ void load_impulse() {
   EXPECT_EQ(loaded, D == 3 ? 2 * 16 : 2 * 4);  // two particle layers of the 2 x 2-cell section
 }
 
-TEST(Loads, ImpulseEqualsMomentum3D) { load_impulse<3>(); }
-TEST(Loads, ImpulseEqualsMomentum2D) { load_impulse<2>(); }
+TEST(Loads, ImpulseEqualsMomentum3D) {
+  load_impulse<3>();
+}
+TEST(Loads, ImpulseEqualsMomentum2D) {
+  load_impulse<2>();
+}
 
 // A rigid block pushes an elastic block at constant speed (no-slip on the nodes it touches).
 // The rigid body keeps its velocity; the material's momentum changes by minus the impulse of
@@ -83,7 +91,8 @@ TEST(Rigid, PushedBlockMomentumBalancesTheRigidForce) {
   }
   const Vec3 dp = solver.balance().momentum - p0;
   EXPECT_GT(dp.x(), 0.0);  // pushed along +x
-  EXPECT_LT((dp + impulse).norm(), 1e-6 * dp.norm()) << dp.transpose() << " vs " << impulse.transpose();
+  EXPECT_LT((dp + impulse).norm(), 1e-6 * dp.norm())
+      << dp.transpose() << " vs " << impulse.transpose();
   // Rigid particles kept their velocity and moved with it.
   auto p = view<3>(cols);
   for (std::size_t i = 0; i < p.n; ++i)

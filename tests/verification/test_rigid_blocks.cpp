@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 
 #include "fixtures.hpp"
-#include "mpm/explicit_solver.hpp"
-#include "mpm/implicit/implicit_solver.hpp"
+#include "mpm/solver/explicit/explicit_solver.hpp"
+#include "mpm/solver/implicit/implicit_solver.hpp"
 
 namespace mpm {
 namespace {

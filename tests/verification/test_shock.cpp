@@ -31,7 +31,7 @@
 #include <cmath>
 
 #include "fixtures.hpp"
-#include "mpm/explicit_solver.hpp"
+#include "mpm/solver/explicit/explicit_solver.hpp"
 
 namespace mpm {
 namespace {
@@ -120,10 +120,11 @@ TEST(Shock, SymmetricLeadImpactMatchesRankineHugoniot) {
       EXPECT_LT(r.energy_drift, 0.01) << tag;
       EXPECT_GT(r.energy_drift, -0.08) << tag;
     }
-    std::printf("%s: rho %.0f (R-H %.0f), e %.3f MJ/kg (%.3f), |v| %.0f m/s, shock at %.3f mm "
-                "(%.3f), interface pressure %.1f GPa (%.1f), energy drift %+.2f%%\n",
-                tag, r.rho, rhoH, r.e / 1e6, eH / 1e6, r.v, r.x_shock * 1e3, (Us - up) * t * 1e3,
-                r.p_interface / 1e9, pH / 1e9, 100 * r.energy_drift);
+    std::printf(
+        "%s: rho %.0f (R-H %.0f), e %.3f MJ/kg (%.3f), |v| %.0f m/s, shock at %.3f mm "
+        "(%.3f), interface pressure %.1f GPa (%.1f), energy drift %+.2f%%\n",
+        tag, r.rho, rhoH, r.e / 1e6, eH / 1e6, r.v, r.x_shock * 1e3, (Us - up) * t * 1e3,
+        r.p_interface / 1e9, pH / 1e9, 100 * r.energy_drift);
   }
 }
 

@@ -5,12 +5,12 @@
 
 #include <filesystem>
 
-#include "mpm/explicit_solver.hpp"
-#include "mpm/graded_solver.hpp"
-#include "mpm/graded_voxelise.hpp"
-#include "mpm/lattice.hpp"
-#include "mpm/sparse_solver.hpp"
-#include "mpm/voxelise.hpp"
+#include "mpm/grid/lattice.hpp"
+#include "mpm/prep/graded_voxelise.hpp"
+#include "mpm/prep/voxelise.hpp"
+#include "mpm/solver/explicit/explicit_solver.hpp"
+#include "mpm/solver/explicit/graded_solver.hpp"
+#include "mpm/solver/explicit/sparse_solver.hpp"
 
 namespace mpm {
 namespace {
@@ -29,8 +29,8 @@ ColumnStore taylor(ScatterStrategy strategy, int threads, bool graded = false, b
   const Scene scene = load_scene(path, sets);
   const Lattice lat = make_lattice(scene);
   std::vector<BodyReport> report;
-  ColumnStore cols = graded ? std::move(prepare_graded(scene, lat, report).columns)
-                            : voxelise(scene, lat, report);
+  ColumnStore cols =
+      graded ? std::move(prepare_graded(scene, lat, report).columns) : voxelise(scene, lat, report);
   const int saved = omp_get_max_threads();
   omp_set_num_threads(threads);
   auto run = [&](auto& solver) {
@@ -63,7 +63,8 @@ bool bitwise_equal(const ColumnStore& a, const ColumnStore& b) {
   if (a.size() != b.size() || a.columns().size() != b.columns().size()) return false;
   for (const auto& c : a.columns()) {
     const Column* d = b.find(c.info().name);
-    if (!d || d->bytes() != c.bytes() || std::memcmp(c.data(), d->data(), c.bytes()) != 0) return false;
+    if (!d || d->bytes() != c.bytes() || std::memcmp(c.data(), d->data(), c.bytes()) != 0)
+      return false;
   }
   return true;
 }
@@ -82,7 +83,8 @@ TEST(Strategies, AllAgreeToRoundOffOnTheTaylorBar) {
   const ColumnStore ref = taylor(ScatterStrategy::Colored, 2);
   const auto* x0 = reinterpret_cast<const Vec3*>(ref.at(col::x).data());
   const auto* s0 = reinterpret_cast<const Sym*>(ref.at(col::sigma).data());
-  for (ScatterStrategy st : {ScatterStrategy::LRSlabs, ScatterStrategy::ArrayExpansion, ScatterStrategy::Patch}) {
+  for (ScatterStrategy st :
+       {ScatterStrategy::LRSlabs, ScatterStrategy::ArrayExpansion, ScatterStrategy::Patch}) {
     const ColumnStore other = taylor(st, 2);
     ASSERT_EQ(other.size(), ref.size());
     const auto* x1 = reinterpret_cast<const Vec3*>(other.at(col::x).data());

@@ -1,0 +1,67 @@
+#pragma once
+/// Bodies to particles (mpm-prep). Each body becomes n x n x n particles per cell (n x n in 2D)
+/// at cell-aligned positions (cell corner + (i + 1/2) h / n) that lie inside the body, or, with
+/// particle_spacing s, the points inside it of a lattice of spacing s centred on its bounding
+/// box (round(L / s) points along each extent L), whatever the cells.
+/// Primitives use exact inside tests; meshes (STL, OFF, OBJ) use CGAL's Side_of_triangle_mesh
+/// on an AABB tree and must be closed.
+#include <array>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mpm/core/columns.hpp"
+#include "mpm/grid/lattice.hpp"
+#include "mpm/scene/scene.hpp"
+
+namespace mpm {
+
+/// A body's region in world coordinates (after scale, rotation, translation).
+class Region {
+ public:
+  virtual ~Region() = default;
+  /// True when x (m) is inside (points exactly on the surface may go either way).
+  virtual bool contains(const Vec3& x) const = 0;
+  /// Exact volume (m^3; in 2D the area in m^2): analytic for primitives, the closed mesh's
+  /// signed volume for meshes.
+  virtual double volume() const = 0;
+  /// Axisymmetric 2D scenes: the volume per radian of the solid of revolution about the y
+  /// axis swept by the part of the region at x >= 0, the integral of x over that part (m^3).
+  /// Exact for the 2D primitives (rectangles, disks and their rotated, scaled images).
+  virtual double revolved_volume() const;
+  /// World-space bounding box.
+  virtual void bounds(Vec3& lo, Vec3& hi) const = 0;
+};
+
+/// The region of a body. Reads and checks the mesh file for meshes.
+/// Throws InputError naming the body's scene key and the file when the mesh cannot be read,
+/// is empty, or is not closed.
+std::unique_ptr<Region> make_region(const BodySpec& body, const Scene& scene);
+
+/// What voxelisation produced for one body.
+struct BodyReport {
+  std::string name;
+  std::size_t particles = 0;
+  double mass = 0;                  ///< sum of particle masses, kg (per metre of thickness in 2D)
+  double exact_mass = 0;            ///< density x exact volume, kg
+  double spacing = 0;               ///< particle spacing (h / n, or particle_spacing), m
+  std::size_t skipped_overlap = 0;  ///< points inside an earlier body, not created again
+};
+
+/// Which cells of the lattice voxelise fills: one level of a graded grid (graded_voxelise.hpp).
+struct VoxeliseCells {
+  /// Keeps a cell (global index along x, y, z; z = 0 in 2D); empty: every cell.
+  std::function<bool(const std::array<long long, 3>&)> keep;
+  bool allow_empty = false;  ///< a body may get no particle in these cells
+};
+
+/// Particles of all bodies, in body order. Columns: id (u32), body (u8), material (u8),
+/// x (dim x f64, m), v (dim x f64, m/s), m (f64, kg), rho (f64, kg/m^3).
+/// A point inside an earlier body is not created again (the earlier body owns it).
+/// Throws InputError when a body gets no particle (naming the body and its scene line).
+/// With `cells`, only the cells it keeps are filled (and, with allow_empty, a body may get none).
+ColumnStore voxelise(const Scene& scene, const Lattice& lattice, std::vector<BodyReport>& report,
+                     const VoxeliseCells& cells = {});
+
+}  // namespace mpm

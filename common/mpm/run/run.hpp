@@ -1,0 +1,28 @@
+#pragma once
+/// mpm-run: reads a model stream, runs the solver the scene asks for, writes a result stream.
+#include <string>
+#include <vector>
+
+#include "mpm/core/progress.hpp"
+
+namespace mpm {
+
+struct RunOptions {
+  std::string input = "-";             ///< model stream ("-": stdin)
+  std::string output = "-";            ///< result stream ("-": stdout)
+  int threads = 0;                     ///< OpenMP threads; 0: the OpenMP default
+  std::vector<std::string> overrides;  ///< --set key=value
+  bool stats = false;                  ///< print the kernel time table at the end
+  std::string strategy = "colored";    ///< particle-to-grid scatter strategy
+  bool deterministic = false;          ///< results independent of the thread count
+  ProgressMode progress = ProgressMode::Auto;
+};
+
+/// Runs a model to its end time. Returns the exit status (ExitStatus); errors in the input
+/// throw InputError/StreamError, write failures IoError.
+int run_model(const RunOptions& options);
+
+/// Face names in BoundarySpec order: x_min, x_max, y_min, y_max, z_min, z_max.
+const char* face_name(int face);
+
+}  // namespace mpm

@@ -1,0 +1,134 @@
+#include "mpm/scene/particles.hpp"
+
+#include <algorithm>
+
+#include "mpm/core/error.hpp"
+
+namespace mpm {
+
+ColumnNeeds column_needs(const Scene& scene) {
+  ColumnNeeds need;
+  for (const auto& mat : scene.materials) {
+    if (mat.strength.model != StrengthModel::Elastic) need.eps_p = true;
+    if (mat.strength.thermal()) need.T = true;
+    if (mat.failure.enabled()) need.failed = need.eps_p = true;
+  }
+  return need;
+}
+
+namespace {
+void require(const ColumnStore& cols, const std::string& name, ScalarType type, int comps) {
+  const Column* c = cols.find(name);
+  if (!c) throw InputError("model", "particle column '" + name + "' is missing");
+  if (c->info().type != type || c->info().components != comps)
+    throw InputError("model", "particle column '" + name + "' holds " +
+                                  std::to_string(c->info().components) + " x " +
+                                  scalar_name(c->info().type) + ", expected " +
+                                  std::to_string(comps) + " x " + scalar_name(type));
+}
+void ensure(ColumnStore& cols, const ColumnInfo& info) {
+  if (cols.find(info.name)) {
+    require(cols, info.name, info.type, info.components);
+    return;
+  }
+  cols.add(info);
+}
+}  // namespace
+
+void prepare_columns(ColumnStore& cols, const Scene& scene) {
+  const int d = scene.dimension;
+  require(cols, col::x, ScalarType::F64, d);
+  require(cols, col::v, ScalarType::F64, d);
+  require(cols, col::m, ScalarType::F64, 1);
+  require(cols, col::rho, ScalarType::F64, 1);
+  require(cols, col::id, ScalarType::U32, 1);
+  require(cols, col::material, ScalarType::U8, 1);
+  require(cols, col::body, ScalarType::U8, 1);
+  const auto* mat = cols.get<std::uint8_t>(col::material);
+  const auto* body = cols.get<std::uint8_t>(col::body);
+  for (std::size_t i = 0; i < cols.size(); ++i) {
+    if (body[i] >= scene.bodies.size())
+      throw InputError("model", "particle " + std::to_string(i) + " refers to body " +
+                                    std::to_string(body[i]) + " but the scene has " +
+                                    std::to_string(scene.bodies.size()));
+    if (mat[i] == kRigidMaterial && scene.bodies[body[i]].rigid) continue;
+    if (mat[i] >= scene.materials.size())
+      throw InputError("model", "particle " + std::to_string(i) + " refers to material " +
+                                    std::to_string(mat[i]) + " but the scene has " +
+                                    std::to_string(scene.materials.size()));
+  }
+  ensure(cols, {col::sigma, ScalarType::F64, 6, "Pa"});
+  ensure(cols, {col::e, ScalarType::F64, 1, "J/kg"});
+  const ColumnNeeds need = column_needs(scene);
+  if (need.eps_p) ensure(cols, {col::eps_p, ScalarType::F64, 1, "-"});
+  if (need.failed) ensure(cols, {col::failed, ScalarType::U8, 1, "-"});
+  if (!scene.grid.levels.empty()) {
+    // Graded grids: the strain that places split children (004, eq. 23) and each particle's
+    // level (0 = not yet known: the level it starts in, set by the first split pass).
+    ensure(cols, {col::strain, ScalarType::F64, d, "-"});
+    ensure(cols, {col::level, ScalarType::U8, 1, "-"});
+  }
+  if (d == 2 && scene.plane_stress && !cols.has(col::thickness)) {
+    cols.add({col::thickness, ScalarType::F64, 1, "-"});
+    double* h = cols.get<double>(col::thickness);
+    std::fill(h, h + cols.size(), 1.0);
+  }
+  if (need.T && !cols.has(col::T)) {
+    cols.add({col::T, ScalarType::F64, 1, "K"});
+    double* T = cols.get<double>(col::T);
+    for (std::size_t i = 0; i < cols.size(); ++i)
+      T[i] = mat[i] == kRigidMaterial ? 0.0 : scene.materials[mat[i]].strength.room_temperature;
+  }
+  if (!scene.loads.empty() && !cols.has(col::f_ext)) {
+    // Each load's total force, shared equally among the particles of its body whose position
+    // at t = 0 lies in its region. Axisymmetric: the force is over the whole ring, the
+    // particles' equations are per radian.
+    cols.add({col::f_ext, ScalarType::F64, d, "N"});
+    auto* f = reinterpret_cast<double*>(cols.at(col::f_ext).data());
+    const auto* x = reinterpret_cast<const double*>(cols.at(col::x).data());
+    const double per = 1.0 / scene.measure_factor();
+    for (std::size_t l = 0; l < scene.loads.size(); ++l) {
+      const LoadSpec& load = scene.loads[l];
+      std::vector<std::size_t> picked;
+      for (std::size_t i = 0; i < cols.size(); ++i) {
+        if (body[i] != load.body) continue;
+        bool in = true;
+        for (int a = 0; a < d && load.region_given; ++a)
+          in = in && x[i * d + a] >= load.region_min[a] && x[i * d + a] <= load.region_max[a];
+        if (in) picked.push_back(i);
+      }
+      if (picked.empty())
+        throw InputError(where(load.loc.file, load.loc.line, load.loc.key),
+                         "the load selects no particle of body '" + scene.bodies[load.body].name +
+                             "' (check its region against the body's particles)");
+      for (auto i : picked)
+        for (int a = 0; a < d; ++a) f[i * d + a] += per * load.force[a] / double(picked.size());
+    }
+  }
+}
+
+template <int D>
+ParticleView<D> view(ColumnStore& cols) {
+  ParticleView<D> p;
+  p.n = cols.size();
+  p.x = cols.get<Vec<D>>(col::x);
+  p.v = cols.get<Vec<D>>(col::v);
+  p.m = cols.get<double>(col::m);
+  p.rho = cols.get<double>(col::rho);
+  p.sigma = cols.get<Sym>(col::sigma);
+  p.e = cols.get<double>(col::e);
+  p.eps_p = cols.get<double>(col::eps_p);
+  p.T = cols.get<double>(col::T);
+  p.failed = cols.get<std::uint8_t>(col::failed);
+  p.f_ext = cols.get<Vec<D>>(col::f_ext);
+  p.strain = cols.get<Vec<D>>(col::strain);
+  p.thickness = cols.get<double>(col::thickness);
+  p.id = cols.get<std::uint32_t>(col::id);
+  p.material = cols.get<std::uint8_t>(col::material);
+  p.body = cols.get<std::uint8_t>(col::body);
+  return p;
+}
+template ParticleView<2> view<2>(ColumnStore&);
+template ParticleView<3> view<3>(ColumnStore&);
+
+}  // namespace mpm

@@ -1,0 +1,82 @@
+#pragma once
+/// Particles are named columns (structure of arrays) kept in cell order. Only the columns the
+/// scene's materials need exist: no eps_p without plasticity, no T without thermal softening,
+/// no failed flag without a failure model.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "mpm/core/columns.hpp"
+#include "mpm/core/types.hpp"
+#include "mpm/scene/scene.hpp"
+
+namespace mpm {
+
+/// Column names used by the tools (also the field names in frames and VTK files).
+namespace col {
+inline const std::string id = "id";              ///< u32, stable particle number
+inline const std::string body = "body";          ///< u8, index into Scene::bodies
+inline const std::string material = "material";  ///< u8, index into Scene::materials
+inline const std::string x = "x";                ///< D x f64, position, m
+inline const std::string v = "v";                ///< D x f64, velocity, m/s
+inline const std::string m = "m";                ///< f64, mass, kg (per metre in 2D)
+inline const std::string rho = "rho";            ///< f64, current density, kg/m^3
+inline const std::string sigma = "sigma";        ///< 6 x f64, Cauchy stress (Voigt), Pa
+inline const std::string e = "e";                ///< f64, specific internal energy, J/kg
+inline const std::string eps_p = "eps_p";        ///< f64, equivalent plastic strain
+inline const std::string T = "T";                ///< f64, temperature, K
+inline const std::string failed = "failed";      ///< u8, 1 once the failure criterion was met
+inline const std::string f_ext = "f_ext";        ///< D x f64, applied force (loads), N
+inline const std::string strain = "strain";  ///< D x f64, accumulated normal strains (graded grids)
+inline const std::string level =
+    "level";  ///< u8, grid level of the particle's spacing (graded grids)
+inline const std::string thickness =
+    "thickness";  ///< f64, thickness / initial thickness (plane stress)
+}  // namespace col
+
+/// Material id of the particles of rigid bodies (they have no material).
+inline constexpr std::uint8_t kRigidMaterial = 255;
+
+/// Raw pointers into the particle columns for the kernels; optional columns are nullptr when
+/// absent. Valid until the columns are resized or reordered.
+template <int D>
+struct ParticleView {
+  std::size_t n = 0;
+  Vec<D>* x = nullptr;
+  Vec<D>* v = nullptr;
+  double* m = nullptr;
+  double* rho = nullptr;
+  Sym* sigma = nullptr;
+  double* e = nullptr;
+  double* eps_p = nullptr;
+  double* T = nullptr;
+  std::uint8_t* failed = nullptr;
+  Vec<D>* f_ext = nullptr;
+  Vec<D>* strain = nullptr;     ///< integral of the rate of deformation's diagonal (graded grids)
+  double* thickness = nullptr;  ///< thickness / initial thickness (plane stress)
+  std::uint32_t* id = nullptr;
+  std::uint8_t* material = nullptr;
+  std::uint8_t* body = nullptr;
+};
+
+/// Which optional columns a scene's materials need.
+struct ColumnNeeds {
+  bool eps_p = false;
+  bool T = false;
+  bool failed = false;
+};
+ColumnNeeds column_needs(const Scene& scene);
+
+/// Adds the state columns a run needs to a model's columns (sigma, e and the optional ones),
+/// initialised to the unstressed state (T to each material's room temperature; thickness to 1
+/// in plane stress; f_ext from the
+/// scene's loads, shared equally among the particles each load selects), and checks the
+/// model's own columns (x, v, m, rho, id, material, body) exist with the right shape.
+/// Throws InputError naming the missing or malformed column, or a load that selects nothing.
+void prepare_columns(ColumnStore& cols, const Scene& scene);
+
+/// The view of a column store holding the columns of prepare_columns.
+template <int D>
+ParticleView<D> view(ColumnStore& cols);
+
+}  // namespace mpm

@@ -1,0 +1,265 @@
+#pragma once
+/// The scene: what the user describes in a TOML file (reference: docs/scene.md). Every string
+/// is parsed into an enum or a typed SI value here, once; nothing past the parser sees text.
+#include <array>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "mpm/core/types.hpp"
+
+namespace mpm {
+
+/// Where a value came from, for error messages ("scene.toml:12", or "--set solver.cfl").
+struct SourceLoc {
+  std::string file;
+  int line = 0;
+  std::string key;  ///< dotted path, e.g. "materials.copper.density"
+};
+
+enum class StrengthModel { Elastic, J2, JohnsonCook };
+enum class EosModel { Linear, MieGruneisen };
+
+/// Deviatoric strength. J2: sigma_y = A + B eps_p^n. Johnson-Cook multiplies by
+/// (1 + C ln(rate/rate0)) (1 - T*^m), T* = (T - T_room)/(T_melt - T_room).
+struct StrengthSpec {
+  StrengthModel model = StrengthModel::Elastic;
+  double A = 0;                      ///< initial yield stress, Pa
+  double B = 0;                      ///< hardening modulus, Pa
+  double n = 1;                      ///< hardening exponent
+  double C = 0;                      ///< strain-rate coefficient (Johnson-Cook)
+  double reference_rate = 1.0;       ///< reference plastic strain rate, 1/s
+  double m = 0;                      ///< thermal softening exponent; 0 means no thermal term
+  double room_temperature = 293.0;   ///< K
+  double melt_temperature = 1356.0;  ///< K
+  double specific_heat = 383.0;      ///< J/(kg K)
+  double taylor_quinney = 0.9;       ///< fraction of plastic work turned into heat
+  bool thermal() const { return model == StrengthModel::JohnsonCook && m > 0; }
+};
+
+/// Equation of state. Linear: p = K mu. Mie-Grueneisen (000, eq. 18) with internal energy.
+struct EosSpec {
+  EosModel model = EosModel::Linear;
+  double c0 = 0;      ///< bulk sound speed, m/s
+  double s = 0;       ///< slope of the shock-particle velocity relation
+  double gamma0 = 0;  ///< Grueneisen coefficient
+  /// Mie-Grueneisen in expansion (mu < 0): p = rho0 c0^2 mu + gamma0 E as 000 eq. 18 prints it
+  /// (true), or without the energy term, as the seed authors' own code does (false).
+  bool energy_in_expansion = true;
+};
+
+/// Failure: a failed particle keeps no deviatoric stress and carries no tension.
+struct FailureSpec {
+  double plastic_strain = std::numeric_limits<double>::infinity();  ///< eps_p at failure
+  double pressure = -std::numeric_limits<double>::infinity();       ///< cut-off pressure, Pa
+  bool enabled() const {
+    return plastic_strain < std::numeric_limits<double>::infinity() ||
+           pressure > -std::numeric_limits<double>::infinity();
+  }
+};
+
+struct MaterialSpec {
+  std::string name;
+  double density = 0;         ///< reference density rho_0, kg/m^3
+  double youngs_modulus = 0;  ///< Pa
+  double poisson_ratio = 0;   ///< -
+  StrengthSpec strength;
+  EosSpec eos;
+  FailureSpec failure;
+  SourceLoc loc;
+  double shear_modulus() const { return youngs_modulus / (2 * (1 + poisson_ratio)); }
+  double bulk_modulus() const { return youngs_modulus / (3 * (1 - 2 * poisson_ratio)); }
+};
+
+enum class ShapeKind { Box, Cylinder, Sphere, Mesh };
+
+/// A body: a shape in its local frame, placed by scale, then rotation, then translation.
+/// Local frames: box centred on the origin; cylinder along +z from z = 0 to z = length,
+/// axis through the origin; sphere centred on the origin; mesh as in its file.
+/// In 2D scenes the shapes live in the x-y plane: box is a rectangle, sphere a disk.
+struct BodySpec {
+  std::string name;
+  int material = -1;  ///< index into Scene::materials
+  ShapeKind shape = ShapeKind::Box;
+  Vec3 size = Vec3::Zero();        ///< box edge lengths, m
+  double radius = 0;               ///< cylinder or sphere, m
+  double length = 0;               ///< cylinder, m
+  std::string mesh_path;           ///< STL, OFF or OBJ; relative paths are from the scene file
+  Vec3 scale = Vec3::Ones();       ///< applied first
+  Vec3 rotate_deg = Vec3::Zero();  ///< rotations about x, then y, then z, degrees
+  Vec3 translate = Vec3::Zero();   ///< applied last, m
+  Vec3 velocity = Vec3::Zero();    ///< initial velocity, m/s (rigid bodies: kept for ever)
+  int particles_per_cell = 2;      ///< per axis: n x n x n particles in each cell
+  /// Particle spacing, m, when given (particle_spacing): a lattice of its own, centred on the
+  /// body, independent of the cells; 0: cell_size / particles_per_cell.
+  double particle_spacing = 0;
+  SourceLoc spacing_loc;  ///< where particle_spacing was given (file line or --set)
+  /// The body's particle spacing on cells of size h.
+  double spacing(double h) const {
+    return particle_spacing > 0 ? particle_spacing : h / particles_per_cell;
+  }
+  bool rigid = false;  ///< moves at `velocity` whatever happens
+  /// Rigid bodies: bit a set = the contact is frictionless along axis a (the nodes the body
+  /// touches keep the material's velocity in that component); 0 = no-slip (all components).
+  std::uint8_t slip_axes = 0;
+  SourceLoc loc;
+};
+
+/// A constant force applied from t = 0 to the particles of a body inside a region (all of the
+/// body when no region is given), shared equally among them.
+struct LoadSpec {
+  int body = -1;  ///< index into Scene::bodies
+  Vec3 force =
+      Vec3::Zero();  ///< total force, N (plane strain: N per metre; axisymmetric: whole ring)
+  bool region_given = false;
+  Vec3 region_min = Vec3::Zero();  ///< m, initial positions
+  Vec3 region_max = Vec3::Zero();
+  SourceLoc loc;
+};
+
+/// A refined box of a graded grid (004, section 3.1): its cells are cell_size / 2^(level - 1)
+/// across. Boxes are aligned to the lattice of the next coarser level and nested.
+struct LevelSpec {
+  int level = 2;            ///< 2, 3, ...; level 1 is the whole domain
+  Vec3 min = Vec3::Zero();  ///< lower corner, m
+  Vec3 max = Vec3::Zero();  ///< upper corner, m
+  int follow = -1;  ///< index into Scene::bodies: the box moves with its mass centre; -1: fixed
+  SourceLoc loc;    ///< key "grid.levels.<index>"
+};
+
+struct GridSpec {
+  double cell_size = 0;       ///< h, m
+  bool domain_given = false;  ///< else fitted to the bodies with padding
+  Vec3 domain_min = Vec3::Zero();
+  Vec3 domain_max = Vec3::Zero();
+  double padding = 0;             ///< m, added around the bodies when the domain is fitted
+  std::vector<LevelSpec> levels;  ///< refined boxes of a graded grid; empty: a uniform grid
+  /// Nodes only around the occupied cells (sparse_grid.hpp) instead of the dense window over
+  /// the particles' bounding box: for material that spreads (debris clouds). Explicit solver,
+  /// uniform grid.
+  bool sparse = false;
+  SourceLoc loc;
+  /// Number of levels: 1 + the highest refinement (1 for a uniform grid).
+  int level_count() const {
+    int n = 1;
+    for (const auto& l : levels) n = l.level > n ? l.level : n;
+    return n;
+  }
+};
+
+enum class BoundaryType { Free, Slip, Fixed };
+/// Faces in the order x_min, x_max, y_min, y_max, z_min, z_max.
+struct BoundarySpec {
+  std::array<BoundaryType, 6> face{BoundaryType::Free, BoundaryType::Free, BoundaryType::Free,
+                                   BoundaryType::Free, BoundaryType::Free, BoundaryType::Free};
+};
+
+enum class Scheme { USF, USL, MUSL };
+/// What happens to a particle that leaves the domain.
+enum class OnExit { Stop, Remove };
+
+/// Which solver advances the scene in time.
+enum class SolverType { Explicit, Implicit };
+/// Implicit unknowns: grid velocities (symmetric Jacobian, 001 section 2.4) or grid momenta
+/// (non-symmetric, 001 section 3.2).
+enum class Formulation { Velocity, Momentum };
+/// Krylov method of the Newton step: conjugate gradients (symmetric) or GMRES.
+enum class KrylovMethod { CG, GMRES };
+/// Linear tolerance of each Newton step: fixed, or Eisenstat-Walker (choice 2).
+enum class Forcing { Fixed, EisenstatWalker };
+/// Newton's initial guess: the grid velocities (or momenta) from the particles, v^k (001,
+/// Algorithm 1), or the previous step's converged grid velocities where a node had them.
+enum class InitialGuess { Particles, Previous };
+/// Preconditioner of the Krylov solve: none; the Jacobian's diagonal estimated from the
+/// lumped mass and the elastic stiffness; or the whole tangent M + theta dt^2 K_t (the
+/// elastic-plastic stiffness of the particles at the step's start), assembled and factored.
+enum class Preconditioner { None, Diagonal, Tangent };
+
+/// The implicit solver (001, sections 2.4 and 3.2): the theta-scheme of eq. 2.4.1 solved by
+/// matrix-free Newton-Krylov with a backtracking line search. Defaults are the seed's.
+struct ImplicitSpec {
+  double theta = 1.0;  ///< mu of (001, eq. 2.4.1): 0 explicit, 1 fully implicit
+  Formulation formulation = Formulation::Momentum;
+  KrylovMethod krylov = KrylovMethod::GMRES;  ///< default: CG for velocity, GMRES for momentum
+  double newton_tolerance = 1e-5;     ///< on ||F||_2 of the dimensionless residual (001 s. 3.2.2)
+  double linear_tolerance = 1e-3;     ///< Krylov: ||J s + F|| <= eta ||F|| (fixed forcing)
+  double derivative_step = 1e-5;      ///< h of the directional difference (001, eq. 2.4.18)
+  int gmres_basis = 20;               ///< Krylov vectors kept by GMRES (001, section 3.2.4)
+  int gmres_restarts = 0;             ///< restarts after a full basis (0: use the basis once)
+  int max_krylov = 200;               ///< CG iterations per Newton step, at most
+  int max_newton = 25;                ///< Newton iterations per step before the step is cut
+  int max_line_search = 8;            ///< halvings of a Newton step before it counts as failed
+  double dt_initial_multiple = 1.0;   ///< first step, in explicit (CFL) steps
+  double dt_target_multiple = 100.0;  ///< largest step, in explicit steps
+  double ramp = 0.2;                  ///< growth of the step per step (001 Tables 1-6: 20%)
+  double cut = 0.5;                   ///< factor on the step after a failed Newton solve
+  int max_cuts = 10;                  ///< cuts of one step before the run stops (exit 3)
+  Forcing forcing = Forcing::EisenstatWalker;  ///< measured to win: examples/implicit/results.md
+  /// Default by measurement too: diagonal for the velocity formulation (CG), none for the
+  /// momentum formulation (GMRES), where the elastic diagonal slowed the plastic upsetting.
+  Preconditioner preconditioner = Preconditioner::None;
+  /// Default by measurement: previous for the velocity formulation (CG), particles for the
+  /// momentum formulation (GMRES), where the contact of the upsetting made it slower.
+  InitialGuess initial_guess = InitialGuess::Particles;
+};
+
+struct SolverSpec {
+  SolverType type = SolverType::Explicit;
+  ImplicitSpec implicit;  ///< used when type is Implicit
+  Scheme scheme = Scheme::MUSL;
+  double cfl = 0.5;                                         ///< dt = cfl * h / max(c + |v|)
+  double end_time = 0;                                      ///< s
+  double dt_max = std::numeric_limits<double>::infinity();  ///< s
+  double bulk_linear = 0.06;    ///< artificial bulk viscosity, linear coefficient
+  double bulk_quadratic = 1.5;  ///< artificial bulk viscosity, quadratic coefficient
+  Vec3 gravity = Vec3::Zero();  ///< body force per unit mass, m/s^2
+  OnExit on_exit = OnExit::Stop;
+  double energy_growth_limit = 0.05;  ///< stop when total energy exceeds its reference by this
+  long max_steps = 0;                 ///< 0: no limit
+};
+
+enum class Precision { Float64, Float32 };
+
+struct OutputSpec {
+  int frames = 10;                  ///< frames written in (0, end_time], plus the initial one
+  double history_interval = 0;      ///< s; 0: every step
+  std::vector<std::string> fields;  ///< particle columns written in frames; empty: all
+  Precision precision = Precision::Float64;
+};
+
+struct Scene {
+  std::string source;     ///< file name (or "<stream>") the scene was read from
+  std::string directory;  ///< directory of the scene file, for relative mesh paths
+  std::string title;
+  int dimension = 3;          ///< 3, or 2 (x-y plane)
+  bool axisymmetric = false;  ///< 2D only: x is the radius, y the axis; else plane strain
+  bool plane_stress = false;  ///< 2D only: sigma_zz = 0, the thickness follows (thin sheets)
+  std::vector<MaterialSpec> materials;
+  std::vector<BodySpec> bodies;
+  std::vector<LoadSpec> loads;
+  GridSpec grid;
+  BoundarySpec boundary;
+  SolverSpec solver;
+  OutputSpec output;
+  std::string toml;  ///< the scene as TOML text after overrides, as stored in streams
+
+  /// Index of a material by name, -1 if absent.
+  int material_index(const std::string& name) const;
+  /// Index of a body by name, -1 if absent.
+  int body_index(const std::string& name) const;
+  /// Factor from the computed quantities (per metre of thickness in plane strain, per radian
+  /// in axisymmetry) to reported totals (whole revolution): 2 pi in axisymmetry, else 1.
+  double measure_factor() const;
+};
+
+/// Parses a scene from TOML text. `source` names it in messages; `directory` resolves relative
+/// mesh paths. `overrides` are "key=value" strings (--set) applied before validation; a value
+/// is read as TOML, or as a string when it is not valid TOML ("0.38mm").
+/// Throws InputError naming the file, line and key of the first mistake.
+Scene parse_scene(const std::string& toml_text, const std::string& source,
+                  const std::string& directory, const std::vector<std::string>& overrides);
+
+/// Reads and parses a scene file ("-" for stdin). Throws InputError.
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides);
+
+}  // namespace mpm

@@ -1,0 +1,141 @@
+#pragma once
+/// Materials are composed of an equation of state, a strength model and a failure rule, each
+/// chosen by name from the scene. The solver calls Material::update once per block of
+/// particles of one material (never once per particle); the strength and EOS are called once
+/// per block too.
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "mpm/core/types.hpp"
+#include "mpm/scene/scene.hpp"
+
+namespace mpm {
+
+/// Largest number of particles in one block.
+inline constexpr int kBlock = 64;
+
+/// Why a particle's update failed (instability diagnosis).
+enum class PointFault : std::uint8_t { None, VolumeInverted, NonFinite };
+
+/// The particles of one block, in and out of a constitutive update. Arrays hold `n` entries
+/// and point into the particle columns (offset to the block) or into scratch.
+struct MaterialBlock {
+  int n = 0;
+  double dt = 0;                   ///< s
+  double h = 0;                    ///< cell size, m (length scale of the bulk viscosity)
+  const Mat3* L = nullptr;         ///< velocity gradient, 1/s; 3x3 also in 2D (zeros out of plane)
+  const double* m = nullptr;       ///< mass, kg
+  Sym* sigma = nullptr;            ///< Cauchy stress incl. bulk viscosity, Pa (in/out)
+  double* rho = nullptr;           ///< density, kg/m^3 (in/out)
+  double* e = nullptr;             ///< specific internal energy, J/kg (in/out)
+  double* eps_p = nullptr;         ///< equivalent plastic strain (in/out; nullptr if absent)
+  double* T = nullptr;             ///< temperature, K (in/out; nullptr if absent)
+  std::uint8_t* failed = nullptr;  ///< failure flag (in/out; nullptr if absent)
+  double* c = nullptr;             ///< out: signal speed for the time step, m/s
+  /// 2D plane stress: L(2, 2) on entry is ignored; the update finds the thickness rate that
+  /// makes sigma_zz = 0 for each particle (and the density follows the thinning).
+  bool plane_stress = false;
+  double* thickness =
+      nullptr;           ///< plane stress: thickness / initial thickness (in/out; may be null)
+  int fault_index = -1;  ///< out: first particle whose update failed, -1 if none
+  PointFault fault = PointFault::None;
+};
+
+/// Scratch shared by the stages of one block update (owned by the caller, one per thread).
+struct BlockScratch {
+  Sym de[kBlock];                          ///< deviatoric strain increment
+  Sym s[kBlock];                           ///< deviatoric stress (rotated old, then new)
+  Sym s_old[kBlock];                       ///< rotated old deviatoric stress
+  double dvol[kBlock];                     ///< volumetric strain increment tr(D) dt
+  double P_old[kBlock];                    ///< old pressure incl. viscosity, Pa
+  double A[kBlock], B[kBlock], K[kBlock];  ///< EOS: p = A + B e; bulk modulus K
+  double q[kBlock];                        ///< bulk viscosity, Pa
+  double dlambda[kBlock];                  ///< plastic strain increment of this step
+  double yield[kBlock];                    ///< flow stress after the step, Pa
+};
+
+/// Equation of state, written as p = A(rho) + B(rho) e with e the specific internal energy,
+/// so the energy equation can be solved for the new pressure without iteration.
+class Eos {
+ public:
+  virtual ~Eos() = default;
+  /// For each particle i < n: A[i], B[i] and the bulk modulus K[i] (Pa) at density rho[i].
+  virtual void coefficients(int n, const double* rho, double* A, double* B, double* K) const = 0;
+};
+
+/// Deviatoric strength: updates s (the rotated old deviator on entry) by the deviatoric strain
+/// increment de with a radial return, and the plastic strain.
+class Strength {
+ public:
+  virtual ~Strength() = default;
+  /// Columns this model needs beyond the basic state.
+  virtual bool needs_plastic_strain() const { return false; }
+  virtual bool needs_temperature() const { return false; }
+  /// Elastic-predictor / plastic-corrector for a block: in S.s (rotated s_old), S.de; out S.s,
+  /// S.dlambda, S.yield, blk.eps_p, blk.T (adiabatic heating).
+  virtual void update(MaterialBlock& blk, BlockScratch& S, double G) const = 0;
+  /// Flow stress (Pa) at plastic strain eps_p, plastic strain rate (1/s) and temperature (K).
+  virtual double flow_stress(double eps_p, double rate, double T) const = 0;
+};
+
+/// A material: reference properties plus its models.
+class Material {
+ public:
+  Material(const MaterialSpec& spec, const SolverSpec& solver);
+  const MaterialSpec& spec() const { return spec_; }
+  const Strength& strength() const { return *strength_; }
+  const Eos& eos() const { return *eos_; }
+  double shear_modulus() const { return G_; }
+  /// Constitutive update of one block (000, eqs. 12-15; Jaumann rate, radial return, EOS with
+  /// internal energy, artificial bulk viscosity, failure). `S` is per-thread scratch. With
+  /// `blk.plane_stress` the out-of-plane rate is solved for, per particle, by a safeguarded
+  /// secant / false-position iteration on sigma_zz = 0 around the whole update (any strength,
+  /// EOS and failure).
+  void update(MaterialBlock& blk, BlockScratch& S) const;
+  /// Cap on the update passes of a plane-stress block (the first updates the whole block, the
+  /// later ones the particles still iterating).
+  static constexpr int kPlaneStressMaxPasses = 30;
+  /// Signal speed (m/s) of the unstressed material: sqrt((K + 4G/3)/rho0).
+  double reference_wave_speed() const;
+  /// Signal speed (m/s) behind a shock of particle velocity u_p (m/s) into the material at
+  /// rest, as the time step sees it: the Rankine-Hugoniot state of this
+  /// EOS (rho from p(rho, u_p^2 / 2) = rho0 U_s u_p, U_s = u_p rho / (rho - rho0)), its
+  /// isentropic sound speed, widened by the bulk viscosity with |tr D| = u_p / h (h cancels), plus
+  /// u_p. For estimates (mpm-prep); the reference speed when u_p = 0.
+  double shocked_signal_speed(double u_p) const;
+  /// Density (kg/m^3) of the Rankine-Hugoniot state of a shock of particle velocity u_p > 0
+  /// into the material at rest: the root of p(rho, u_p^2 / 2) = rho0 u_p^2 rho / (rho - rho0);
+  /// 0 if there is none below 20 rho0.
+  double hugoniot_density(double u_p) const;
+
+ private:
+  void update_once(MaterialBlock& blk, BlockScratch& S) const;
+  void update_plane_stress(MaterialBlock& blk, BlockScratch& S) const;
+
+  MaterialSpec spec_;
+  double G_ = 0, K_ = 0;
+  double K0_eos_ = 0;  ///< the EOS's bulk modulus at rho0, Pa
+  double bulk_linear_ = 0, bulk_quadratic_ = 0;
+  std::unique_ptr<Strength> strength_;
+  std::unique_ptr<Eos> eos_;
+};
+
+/// Factories by name. One explicit function registers the built-in models
+/// (no static-initialiser registration: a static library would drop it).
+using StrengthFactory = std::function<std::unique_ptr<Strength>(const MaterialSpec&)>;
+using EosFactory = std::function<std::unique_ptr<Eos>(const MaterialSpec&)>;
+struct ModelRegistry {
+  std::map<std::string, StrengthFactory> strength;
+  std::map<std::string, EosFactory> eos;
+};
+/// The registry with every built-in model: strength "elastic", "j2", "johnson-cook";
+/// eos "linear", "mie-gruneisen".
+const ModelRegistry& model_registry();
+/// Registry key of a scene enum.
+std::string to_string(StrengthModel m);
+std::string to_string(EosModel m);
+
+}  // namespace mpm

@@ -1,0 +1,15 @@
+#pragma once
+/// Constructors of the built-in models, used by the registry in material.cpp.
+#include <memory>
+
+#include "mpm/solver/materials/material.hpp"
+
+namespace mpm {
+std::unique_ptr<Eos> make_linear_eos(const MaterialSpec& m);
+std::unique_ptr<Eos> make_mie_gruneisen_eos(const MaterialSpec& m);
+std::unique_ptr<Strength> make_elastic_strength(const MaterialSpec& m);
+/// Isotropic hardening sigma_y = A + B eps_p^n (no rate or thermal term).
+std::unique_ptr<Strength> make_j2_strength(const MaterialSpec& m);
+/// Johnson-Cook: (A + B eps_p^n)(1 + C ln(rate/rate0))(1 - T*^m), adiabatic heating.
+std::unique_ptr<Strength> make_johnson_cook_strength(const MaterialSpec& m);
+}  // namespace mpm
