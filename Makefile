@@ -10,9 +10,9 @@ CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
 DEB_PACKAGES = build-essential cmake pkg-config libeigen3-dev libcgal-dev libvtk9-dev \
   libcli11-dev libgtest-dev googletest libtomlplusplus-dev zlib1g-dev xvfb xauth hyperfine \
-  gnuplot-nox python3 bc
+  gnuplot-nox python3 bc clang-format ccache
 
-.PHONY: all deps build demo test test-long bench clean format
+.PHONY: all deps build demo test test-long bench clean format layout
 
 all: build
 
@@ -26,6 +26,12 @@ deps:
 	  $$SUDO apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing; \
 	else echo "dependencies: all present"; fi
+
+# ccache, when present, makes rebuilds in other build folders (sanitizers, fuzzers) cheap.
+CCACHE := $(shell command -v ccache 2>/dev/null)
+ifneq ($(CCACHE),)
+CMAKE_FLAGS += -DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache
+endif
 
 build: deps
 	cmake -S . -B $(BUILD) $(CMAKE_FLAGS)
@@ -45,6 +51,11 @@ bench: build
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')
+
+# The house rules: includes run downward only, file and function sizes, formatting (also in
+# make test as Layout.*).
+layout:
+	for r in includes sizes format; do python3 tests/tools/check_layout.py . $$r || exit 1; done
 
 clean:
 	rm -rf $(BUILD)
