@@ -13,6 +13,9 @@ namespace mpm {
 
 enum class ScalarType : std::uint8_t { F64 = 1, F32 = 2, U8 = 3, U32 = 4, I32 = 5, U64 = 6 };
 
+/// Floating-point precision of the frames a run writes (output.precision).
+enum class Precision { Float64, Float32 };
+
 /// Size in bytes of one scalar of a type.
 std::size_t scalar_size(ScalarType t);
 /// Short name of a type: "f64", "f32", "u8", "u32", "i32", "u64".

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "mpm/core/columns.hpp"
 #include "mpm/core/types.hpp"
 
 namespace mpm {
@@ -217,8 +218,6 @@ struct SolverSpec {
   double energy_growth_limit = 0.05;  ///< stop when total energy exceeds its reference by this
   long max_steps = 0;                 ///< 0: no limit
 };
-
-enum class Precision { Float64, Float32 };
 
 struct OutputSpec {
   int frames = 10;                  ///< frames written in (0, end_time], plus the initial one

@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "mpm/core/columns.hpp"
-#include "mpm/scene/scene.hpp"
 
 namespace mpm {
 
@@ -70,7 +69,7 @@ class StreamWriter {
   /// Float32 precision stores f64 columns as f32, except "x" (positions keep f64).
   void write_frame(const Frame& frame, const std::vector<std::string>& fields = {},
                    Precision precision = Precision::Float64);
-  /// Writes a record of binary payload (GRID: encode_grid in graded_grid.hpp).
+  /// Writes a record of binary payload (GRID: encode_grid in grid_record.hpp).
   void write_record(RecordType type, const std::vector<std::byte>& payload);
   /// Writes a HIST record (names and units must have the same size, values a multiple of it).
   void write_history(const HistoryBlock& block);
@@ -176,7 +175,7 @@ struct StreamVisitor {
   std::function<void(Frame&&)> frame;
   std::function<void(HistoryBlock&&)> history;
   std::function<void(int, const std::string&)> end;
-  /// GRID payloads (decode_grid in graded_grid.hpp); skipped when empty.
+  /// GRID payloads (decode_grid in grid_record.hpp); skipped when empty.
   std::function<void(std::vector<std::byte>&&)> grid;
   bool want_frames = true;  ///< false: frames are skipped without decoding
 };

@@ -54,7 +54,7 @@
 
 #include "mpm/core/error.hpp"
 #include "mpm/core/types.hpp"
-#include "mpm/grid/graded_grid.hpp"
+#include "mpm/stream/grid_record.hpp"
 
 namespace mpm {
 namespace {

@@ -8,7 +8,7 @@
 
 namespace mpm {
 
-struct GridMesh;  // graded_grid.hpp
+struct GridMesh;  // stream/grid_record.hpp
 
 /// Writes a frame as a VTK XML unstructured grid (.vtu) of vertex cells, one per particle,
 /// with every column but "x" as point data of its own type (u8 -> vtkUnsignedCharArray,
