@@ -16,10 +16,10 @@
 #include "mpm/core/error.hpp"
 #include "mpm/core/units.hpp"
 #include "mpm/core/version.hpp"
-#include "mpm/stream/grid_record.hpp"
 #include "mpm/post/post.hpp"
 #include "mpm/post/profile.hpp"
 #include "mpm/post/vtk/vtk_output.hpp"
+#include "mpm/stream/grid_record.hpp"
 #include "mpm/stream/stream.hpp"
 
 namespace {
