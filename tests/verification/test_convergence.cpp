@@ -17,11 +17,6 @@
 namespace mpm {
 namespace {
 
-using testing::block;
-using testing::elastic;
-using testing::lattice;
-using testing::scene_with;
-
 /// A 2D plane-strain problem with its exact solution in material coordinates X (m) and time
 /// t (s): displacement (m), velocity (m/s), stress (Pa) and, if any, body force per unit mass
 /// (m/s^2).
@@ -62,14 +57,14 @@ Offsets offsets(Scheme scheme) {
 Errors run(const Problem& pr, Scheme scheme, int cells) {
   const double h = pr.length / cells;
   const double rho = pr.material.density;
-  Scene s = scene_with(pr.material, 2, h, 1.0);
+  Scene s = testing::scene_with(pr.material, 2, h, 1.0);
   s.solver.scheme = scheme;
   s.boundary = pr.boundary;
   s.solver.energy_growth_limit = pr.energy_growth_limit;
   const int ny = pr.square ? cells : 1;
-  const Lattice lat = lattice(2, Vec3::Zero(), h, {cells, ny, 1});
-  ColumnStore cols = block<2>(lat, IVec<2>(0, 0), IVec<2>(cells, ny), 2, rho,
-                              [&](const Vec<2>& X) { return pr.v(X, 0); });
+  const Lattice lat = testing::lattice(2, Vec3::Zero(), h, {cells, ny, 1});
+  ColumnStore cols = testing::block<2>(lat, IVec<2>(0, 0), IVec<2>(cells, ny), 2, rho,
+                                       [&](const Vec<2>& X) { return pr.v(X, 0); });
   if (pr.b) cols.add({col::f_ext, ScalarType::F64, 2, "N"});
   const std::vector<Vec<2>> X(cols.get<Vec<2>>(col::x), cols.get<Vec<2>>(col::x) + cols.size());
   UniformSolver<2> solver(s, UniformGrid<2>(lat, s.boundary), cols);
@@ -150,7 +145,7 @@ Problem wave_rod() {
   pr.name = "wave rod";
   const double E = 100e9, rho = 5000, L = 0.1, v0 = 1e-3;
   const double c = std::sqrt(E / rho), k = M_PI / L, w = c * k;
-  pr.material = elastic(E, 0.0, rho);
+  pr.material = testing::elastic(E, 0.0, rho);
   pr.boundary.face = {BoundaryType::Fixed, BoundaryType::Fixed, BoundaryType::Slip,
                       BoundaryType::Slip,  BoundaryType::Slip,  BoundaryType::Slip};
   pr.length = L;
@@ -185,7 +180,7 @@ Problem manufactured() {
   const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
   const double cp = std::sqrt((lambda + 2 * mu) / rho), a = M_PI / L, w = a * cp;
   const double A = 2e-7 / a;  // strain amplitude 2e-7
-  pr.material = elastic(E, nu, rho);
+  pr.material = testing::elastic(E, nu, rho);
   // The energy balance counts the work of a load with the velocity after the update, not the
   // mean of the two half-step velocities its kinetic energy pairs: an O(dt) error, large when
   // the load drives the motion as here (growth 8% of the energy at 16 cells, 4% at 32, 2% at
