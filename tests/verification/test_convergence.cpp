@@ -129,8 +129,10 @@ Study study(const Problem& pr, Scheme scheme, const std::vector<int>& cells) {
            std::log2(st.e[k - 1].sigma_cell / st.e[k].sigma_cell)};
       st.rate.push_back(r);
     }
-    std::printf("  %4d  %.3e  %.3e  %.3e  %.3e  (%.2f  %.2f  %.2f  %.2f)\n", cells[k], st.e[k].u,
-                st.e[k].v, st.e[k].sigma, st.e[k].sigma_cell, r.u, r.v, r.sigma, r.sigma_cell);
+    std::printf("  %4d  %.3e  %.3e  %.3e  %.3e", cells[k], st.e[k].u, st.e[k].v, st.e[k].sigma,
+                st.e[k].sigma_cell);
+    if (k > 0) std::printf("  (%.2f  %.2f  %.2f  %.2f)", r.u, r.v, r.sigma, r.sigma_cell);
+    std::printf("\n");
   }
   return st;
 }
