@@ -17,14 +17,6 @@
 
 namespace mpm {
 
-namespace {
-
-const char* axis_name(int a) {
-  return a == 0 ? "x" : a == 1 ? "y" : "z";
-}
-
-}  // namespace
-
 template <int D>
 std::string GradedGrid<D>::mm(const Vec<D>& x) const {
   std::string s;
