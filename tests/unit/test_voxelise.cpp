@@ -21,6 +21,7 @@
 
 #include "mpm/core/error.hpp"
 #include "mpm/grid/lattice.hpp"
+#include "mpm/prep/region.hpp"
 #include "mpm/prep/voxelise.hpp"
 
 namespace fs = std::filesystem;
@@ -379,13 +380,13 @@ TEST(MakeLattice, QuotientsJustAboveAnIntegerDoNotAddACell) {
   EXPECT_EQ(make_lattice(s).cells[0], 31);
 }
 
-TEST(MakeLattice, FittedDomainIsTheBodiesBoxPlusPadding) {
+TEST(FitLattice, FittedDomainIsTheBodiesBoxPlusPadding) {
   Scene s = make_scene(3, 0.1, Vec3::Zero(), Vec3::Zero());
   s.grid.domain_given = false;
   s.grid.padding = 0.2;
   s.bodies = {sphere("ball", 0.5, Vec3(1, 2, 3)),
               box("plate", Vec3(0.4, 0.2, 0.1), Vec3(2.0, 2, 3))};
-  const Lattice lat = make_lattice(s);
+  const Lattice lat = fit_lattice(s);
   // x from 0.5 - 0.2 to 2.2 + 0.2; y from 1.5 - 0.2 to 2.5 + 0.2; z likewise.
   EXPECT_NEAR(lat.origin.x(), 0.3, 1e-12);
   EXPECT_NEAR(lat.origin.y(), 1.3, 1e-12);
@@ -398,24 +399,42 @@ TEST(MakeLattice, FittedDomainIsTheBodiesBoxPlusPadding) {
   c.rotate_deg = Vec3(0, 90, 0);
   s.bodies = {c};
   s.grid.padding = 0;
-  const Lattice lc = make_lattice(s);
+  const Lattice lc = fit_lattice(s);
   EXPECT_NEAR(lc.origin.x(), 0.0, 1e-12);
   EXPECT_NEAR(lc.origin.y(), -0.25, 1e-12);
   EXPECT_EQ(lc.cells, (std::array<int, 3>{10, 5, 5}));
 }
 
-TEST(MakeLattice, TwoDimensionsUseXAndYOnly) {
+TEST(FitLattice, TwoDimensionsUseXAndYOnly) {
   Scene s = make_scene(2, 0.05, Vec3::Zero(), Vec3::Zero());
   s.grid.domain_given = false;
   s.grid.padding = 0.1;
   BodySpec d = sphere("disk", 0.5, Vec3(0, 0, 7));  // z is ignored in 2D
   s.bodies = {d};
-  const Lattice lat = make_lattice(s);
+  const Lattice lat = fit_lattice(s);
   EXPECT_EQ(lat.dim, 2);
   EXPECT_EQ(lat.cells, (std::array<int, 3>{24, 24, 1}));
   EXPECT_NEAR(lat.origin.x(), -0.6, 1e-12);
   EXPECT_EQ(lat.origin.z(), 0.0);
   EXPECT_EQ(lat.cell_count(), 24 * 24);
+}
+
+TEST(FitLattice, AGivenDomainIsMakeLattices) {
+  Scene s = make_scene(3, 0.1, Vec3(0, -0.2, 1.0), Vec3(1.0, 0.33, 1.7));
+  s.bodies = {sphere("ball", 0.5, Vec3(1, 2, 3))};  // outside: the domain is not fitted
+  const Lattice a = fit_lattice(s), b = make_lattice(s);
+  EXPECT_EQ(a.origin, b.origin);
+  EXPECT_EQ(a.cells, b.cells);
+}
+
+TEST(MakeLattice, RefusesASceneWithoutDomain) {
+  // mpm-run's scenes always have one (mpm-prep writes it); fitting one is mpm-prep's job.
+  Scene s = make_scene(3, 0.1, Vec3::Zero(), Vec3::Zero());
+  s.grid.domain_given = false;
+  s.bodies = {sphere("ball", 0.5, Vec3(1, 2, 3))};
+  const std::string msg = input_error_of([&] { make_lattice(s); });
+  EXPECT_NE(msg.find("scene.toml:3: grid.domain: the scene gives no domain"), std::string::npos)
+      << msg;
 }
 
 TEST(MakeLattice, RefusesBadCellSizesAndHugeDomains) {
@@ -1055,9 +1074,9 @@ TEST_F(VoxeliseMesh, BadMeshesAreRefusedNamingTheFile) {
   msg = input_error_of([&] { run(s); });
   EXPECT_NE(msg.find("scene.toml:18: bodies.ghost.file"), std::string::npos) << msg;
   EXPECT_NE(msg.find("no_such_mesh.stl"), std::string::npos) << msg;
-  // make_lattice meets the file first when it fits the domain: same message.
+  // fit_lattice meets the file first when it fits the domain: same message.
   s.grid.domain_given = false;
-  EXPECT_EQ(input_error_of([&] { make_lattice(s); }), msg);
+  EXPECT_EQ(input_error_of([&] { fit_lattice(s); }), msg);
   s.grid.domain_given = true;
 
   for (const std::string f : {"garbage.stl", "garbage.off"}) {

@@ -369,4 +369,19 @@ std::string format_mm(double metres) {
   return b;
 }
 
+std::string format_g6(double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+
+std::string format_count(double n) {
+  char buf[64];
+  if (n < 1e18)
+    std::snprintf(buf, sizeof buf, "%.0f", n);
+  else
+    std::snprintf(buf, sizeof buf, "%.3g", n);
+  return buf;
+}
+
 }  // namespace mpm

@@ -53,4 +53,10 @@ std::string describe(const Dimension& d);
 /// A length in metres as millimetres for messages, 6 significant digits, no unit: "0.0475".
 std::string format_mm(double metres);
 
+/// A number for messages, 6 significant digits ("%.6g"): "0.0475", "1e-05".
+std::string format_g6(double x);
+
+/// A count for messages: whole digits below 1e18 ("1000000000000000"), else "%.3g" ("1e+20").
+std::string format_count(double n);
+
 }  // namespace mpm

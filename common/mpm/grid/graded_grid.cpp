@@ -19,8 +19,18 @@ namespace mpm {
 
 namespace {
 
-const char* axis_name(int a) {
-  return a == 0 ? "x" : a == 1 ? "y" : "z";
+/// Visits every cell of a box of cells [lo, hi).
+template <int D, class F>
+void for_cells(const IVec<D>& lo, const IVec<D>& hi, F&& f) {
+  for (int a = 0; a < D; ++a)
+    if (hi[a] <= lo[a]) return;
+  IVec<D> c = lo;
+  while (true) {
+    f(c);
+    int a = 0;
+    while (a < D && ++c[a] == hi[a]) c[a] = lo[a], ++a;
+    if (a == D) break;
+  }
 }
 
 }  // namespace
@@ -134,297 +144,18 @@ GradedGrid<D>::GradedGrid(const Lattice& lattice, const Scene& scene)
 
 template <int D>
 bool GradedGrid<D>::build(bool validate) {
-  const int L = levels_;
   ++builds_;
-  // Slab axis: the window's longest (ties to the highest axis), as UniformGrid.
-  slab_ = D - 1;
-  for (int a = D - 2; a >= 0; --a)
-    if (wn_[a] > wn_[slab_]) slab_ = a;
-  std::int64_t st = 1;
-  for (int a = 0; a < D; ++a) stride1_[a] = st, st *= wn_[a];
-  // Box extents at the current offset.
-  for (Box& b : boxes_) {
-    const int s = 1 << (b.level - 1);
-    for (int a = 0; a < D; ++a) {
-      b.xmin[a] = origin_[a] + level_[b.level].h * double(b.lo[a] + offset_[a] * s);
-      b.xmax[a] = origin_[a] + level_[b.level].h * double(b.hi[a] + offset_[a] * s);
-    }
-  }
-  // A box's cells at the current offset, clipped to the window (empty: hi <= lo somewhere).
-  auto shifted = [&](const Box& b, IVec<D>& lo, IVec<D>& hi) {
-    const int s = 1 << (b.level - 1);
-    lo = (b.lo + offset_ * s).cwiseMax(wlo_ * s);
-    hi = (b.hi + offset_ * s).cwiseMin((wlo_ + wn_) * s);
-    for (int a = 0; a < D; ++a)
-      if (hi[a] <= lo[a]) return false;
-    return true;
-  };
-  auto index = [](const Level& lv, const IVec<D>& c) {
-    std::int64_t idx = 0;
-    for (int a = 0; a < D; ++a) idx += std::int64_t(c[a] - lv.lo[a]) * lv.stride[a];
-    return idx;
-  };
-  auto inside = [](const Level& lv, const IVec<D>& c) {
-    for (int a = 0; a < D; ++a)
-      if (c[a] < lv.lo[a] || c[a] >= lv.lo[a] + lv.n[a]) return false;
-    return true;
-  };
-  auto set_layout = [](Level& lv, const IVec<D>& lo, const IVec<D>& hi) {
-    lv.lo = lo;
-    lv.n = hi - lo;
-    std::int64_t s = 1;
-    for (int a = 0; a < D; ++a) lv.stride[a] = s, s *= lv.n[a];
-    lv.cell.assign(std::size_t(s), kNotInLevel);
-  };
-  // Visits every cell of a box of cells [lo, hi).
-  auto for_cells = [](const IVec<D>& lo, const IVec<D>& hi, auto&& f) {
-    for (int a = 0; a < D; ++a)
-      if (hi[a] <= lo[a]) return;
-    IVec<D> c = lo;
-    while (true) {
-      f(c);
-      int a = 0;
-      while (a < D && ++c[a] == hi[a]) c[a] = lo[a], ++a;
-      if (a == D) break;
-    }
-  };
-
-  // Level regions: level 1 is the window; level l the union of its boxes.
-  set_layout(level_[1], wlo_, wlo_ + wn_);
-  std::fill(level_[1].cell.begin(), level_[1].cell.end(), 0);
-  for (int l = 2; l <= L; ++l) {
-    IVec<D> lo = IVec<D>::Constant(std::numeric_limits<int>::max());
-    IVec<D> hi = IVec<D>::Constant(std::numeric_limits<int>::min());
-    bool any = false;
-    for (const Box& b : boxes_)
-      if (b.level == l) {
-        IVec<D> blo, bhi;
-        if (!shifted(b, blo, bhi)) continue;
-        lo = lo.cwiseMin(blo);
-        hi = hi.cwiseMax(bhi);
-        any = true;
-      }
-    if (!any && validate) {
-      for (const Box& b : boxes_)
-        if (b.level > l)
-          fail(b, "level",
-               "a level-" + std::to_string(b.level) + " box needs level-" + std::to_string(l) +
-                   " boxes around it (levels are nested)");
-    }
-    if (!any) lo = hi = IVec<D>::Zero();
-    Level& lv = level_[l];
-    set_layout(lv, lo, hi);
-    for (const Box& b : boxes_)
-      if (b.level == l) {
-        IVec<D> blo, bhi;
-        if (shifted(b, blo, bhi))
-          for_cells(blo, bhi, [&](const IVec<D>& c) { lv.cell[index(lv, c)] = 0; });
-      }
-  }
-  // Nesting (each box inside the coarser region) and 2:1 balance: a level-l box (l >= 3)
-  // grown by one level-(l-1) cell on every side must stay inside the level-(l-1) region,
-  // except where it meets the domain's faces, so that cells touching at a face, an edge or a
-  // corner differ by at most one level.
-  for (const Box& b : boxes_) {
-    if (!validate) break;  // checked on the whole domain; clipping keeps the rules
-    const int l = b.level;
-    IVec<D> blo, bhi;
-    shifted(b, blo, bhi);
-    const Level& parent = level_[l - 1];
-    const IVec<D> plo = blo / 2, phi = bhi / 2;
-    bool nested = true;
-    for_cells(plo, phi, [&](const IVec<D>& c) {
-      if (!inside(parent, c) || parent.cell[index(parent, c)] == kNotInLevel) nested = false;
-    });
-    if (!nested)
-      fail(b, "",
-           "the level-" + std::to_string(l) + " box [" + mm(b.xmin) + ", " + mm(b.xmax) +
-               "] is not inside the level-" + std::to_string(l - 1) +
-               " region (levels are nested)");
-    if (l < 3) continue;
-    IVec<D> glo = plo - IVec<D>::Ones(), ghi = phi + IVec<D>::Ones();
-    const int sp = 1 << (l - 2);
-    for (int a = 0; a < D; ++a) {
-      glo[a] = std::max(glo[a], 0);
-      ghi[a] = std::min(ghi[a], cells1_[a] * sp);
-    }
-    bool balanced = true;
-    for_cells(glo, ghi, [&](const IVec<D>& c) {
-      if (!inside(parent, c) || parent.cell[index(parent, c)] == kNotInLevel) balanced = false;
-    });
-    if (!balanced)
-      fail(b, "",
-           "the level-" + std::to_string(l) + " box [" + mm(b.xmin) + ", " + mm(b.xmax) +
-               "] comes closer than one level-" + std::to_string(l - 1) + " cell (" +
-               format_mm(parent.h) + " mm) to the edge of the level-" + std::to_string(l - 1) +
-               " region; keep that margin (except at the domain's faces) so that "
-               "neighbouring cells differ by one level at most");
-  }
-  // Refined cells: a level-(l-1) cell covered by level-l cells is no leaf.
-  for (int l = L; l >= 2; --l)
-    for (const Box& b : boxes_)
-      if (b.level == l) {
-        IVec<D> blo, bhi;
-        if (!shifted(b, blo, bhi)) continue;
-        Level& parent = level_[l - 1];
-        for_cells(blo / 2, bhi / 2,
-                  [&](const IVec<D>& c) { parent.cell[index(parent, c)] = kRefined; });
-      }
-
-  // Cell keys: level-1 cells with the slab axis slowest, the leaves inside each depth first;
-  // locate's tree on the way.
-  cells_.clear();
-  std::vector<IVec<D>> cpos;  // leaf position in cells of its level
-  {
-    std::size_t refined = 0;
-    for (int l = 1; l < L; ++l)
-      refined += std::size_t(std::count(level_[l].cell.begin(), level_[l].cell.end(), kRefined));
-    root_.assign(level_[1].cell.size(), -1);
-    tree_.assign(refined << D, -1);  // sized once: the slots below stay valid
-    std::size_t next = 0;
-    int order[D];
-    int k = 0;
-    for (int a = 0; a < D; ++a)
-      if (a != slab_) order[k++] = a;
-    order[D - 1] = slab_;  // slowest
-    auto visit = [&](auto&& self, int l, const IVec<D>& c, int layer, std::int32_t& slot) -> void {
-      Level& lv = level_[l];
-      const std::int64_t idx = index(lv, c);
-      if (lv.cell[idx] == kRefined) {
-        const std::size_t t = next++;
-        slot = std::int32_t(-1 - std::int64_t(t));
-        for (int bits = 0; bits < kCorners<D>; ++bits) {
-          IVec<D> child;
-          for (int a = 0; a < D; ++a) child[a] = 2 * c[a] + ((bits >> a) & 1);
-          self(self, l + 1, child, layer, tree_[(t << D) + bits]);
-        }
-        return;
-      }
-      Cell cell;
-      cell.level = std::uint8_t(l);
-      cell.layer = layer;
-      slot = lv.cell[idx] = std::int32_t(cells_.size());
-      cells_.push_back(cell);
-      cpos.push_back(c);
-    };
-    IVec<D> c = wlo_;
-    while (true) {
-      std::int64_t idx1 = 0;
-      for (int a = 0; a < D; ++a) idx1 += (c[a] - wlo_[a]) * stride1_[a];
-      visit(visit, 1, c, c[slab_] - wlo_[slab_], root_[idx1]);
-      int q = 0;
-      while (q < D && ++c[order[q]] == wlo_[order[q]] + wn_[order[q]])
-        c[order[q]] = wlo_[order[q]], ++q;
-      if (q == D) break;
-    }
-  }
+  place_boxes();
+  build_regions(validate);
+  if (validate) check_nesting();  // checked on the whole domain; clipping keeps the rules
+  mark_refined();
+  const std::vector<IVec<D>> cpos = number_cells();
   if (cells_.size() > std::size_t(std::numeric_limits<std::int32_t>::max()))
     throw std::runtime_error("graded grid of " + std::to_string(cells_.size()) +
                              " cells exceeds 2^31; use larger cells");
-
-  // Nodes: one list for all levels. A node is stored once, at the coarsest level whose
-  // lattice holds it, in a dense array over that level's region (nodes of the bounding box).
-  std::vector<Level> nodes_of(L + 1);
-  for (int l = 1; l <= L; ++l) {
-    Level& nl = nodes_of[l];
-    nl.lo = level_[l].lo;
-    nl.n = level_[l].n + IVec<D>::Ones();
-    std::int64_t s = 1;
-    for (int a = 0; a < D; ++a) nl.stride[a] = s, s *= nl.n[a];
-    nl.cell.assign(std::size_t(s), -1);
-  }
-  node_ijk_.clear();
-  // Node slot of a point P (in finest cells); nullptr when no level's node array holds it.
-  auto slot = [&](const IVec<D>& P) -> std::int32_t* {
-    int tz = L - 1;
-    for (int a = 0; a < D; ++a)
-      if (P[a] != 0) tz = std::min(tz, std::countr_zero(unsigned(P[a])));
-    const int k = L - tz;  // the coarsest level whose lattice holds P
-    Level& nl = nodes_of[k];
-    IVec<D> q;
-    for (int a = 0; a < D; ++a) q[a] = P[a] >> (L - k);
-    std::int64_t idx = 0;
-    for (int a = 0; a < D; ++a) {
-      const int c = q[a] - nl.lo[a];
-      if (c < 0 || c >= nl.n[a]) return nullptr;
-      idx += std::int64_t(c) * nl.stride[a];
-    }
-    return &nl.cell[idx];
-  };
-  for (std::size_t key = 0; key < cells_.size(); ++key) {
-    Cell& cell = cells_[key];
-    const int sh = L - cell.level;
-    for (int c = 0; c < kCorners<D>; ++c) {
-      IVec<D> P;
-      for (int a = 0; a < D; ++a) P[a] = (cpos[key][a] + ((c >> a) & 1)) << sh;
-      std::int32_t* s = slot(P);
-      if (!s) throw std::logic_error("graded grid: a corner node lies outside its level's region");
-      if (*s < 0) {
-        *s = std::int32_t(node_ijk_.size());
-        node_ijk_.push_back(P);
-      }
-      cell.corner[c] = *s;
-    }
-  }
-  // Optional nodes: the mid-edge and mid-face points of a cell that are corners of finer
-  // cells (hanging nodes), in increasing number (transition_shape.hpp).
-  optional_.clear();
-  hanging_.assign(node_ijk_.size(), 0);
-  const TransitionTopology<D>& T = kTransition<D>;
-  std::map<std::uint32_t, double> mask_min;
-  for (std::size_t key = 0; key < cells_.size(); ++key) {
-    Cell& cell = cells_[key];
-    cell.opt = std::uint32_t(optional_.size());
-    if (cell.level == L) continue;
-    const int sh = L - cell.level - 1;  // half a cell, in finest cells: 2^sh
-    for (int k = kCorners<D>; k < kTransitionNodes<D>; ++k) {
-      IVec<D> P;
-      for (int a = 0; a < D; ++a) P[a] = (cpos[key][a] << (sh + 1)) + ((T.p[k][a] + 1) << sh);
-      const std::int32_t* s = slot(P);
-      if (!s || *s < 0) continue;
-      cell.mask |= 1u << (k - kCorners<D>);
-      optional_.push_back(*s);
-      hanging_[*s] = 1;
-    }
-    if (cell.mask == 0) continue;
-    auto [it, fresh] = mask_min.try_emplace(cell.mask, 0.0);
-    if (fresh) it->second = transition_min_value<D>(cell.mask);
-    if (it->second < -1e-12 && !validate) return false;  // clipped badly: use a larger window
-    if (it->second < -1e-12) {
-      // Name the finer box nearest to the cell.
-      Vec<D> centre;
-      for (int a = 0; a < D; ++a)
-        centre[a] = origin_[a] + level_[cell.level].h * (cpos[key][a] + 0.5);
-      const Box* nearest = &boxes_.front();
-      double best = 1e300;
-      for (const Box& b : boxes_) {
-        if (b.level != cell.level + 1) continue;
-        double d = 0;
-        for (int a = 0; a < D; ++a)
-          d += std::pow(std::max({b.xmin[a] - centre[a], centre[a] - b.xmax[a], 0.0}), 2);
-        if (d < best) best = d, nearest = &b;
-      }
-      fail(*nearest, "",
-           "the level-" + std::to_string(cell.level + 1) + " boxes meet the level-" +
-               std::to_string(cell.level) + " cell at " + mm(centre) +
-               " on two sides (a concave corner); its transition shape functions would be "
-               "negative there. Merge the boxes into one, or keep them at least one level-" +
-               std::to_string(cell.level) + " cell apart");
-    }
-  }
-
-  // Boundary conditions on the constrained domain faces (hanging nodes included).
-  fixed_.clear();
-  slip_.clear();
-  for (std::size_t n = 0; n < node_ijk_.size(); ++n)
-    for (int face = 0; face < 2 * D; ++face) {
-      const BoundaryType type = boundary_.face[face];
-      if (type == BoundaryType::Free) continue;
-      const int axis = face / 2;
-      const int plane = face % 2 == 0 ? 0 : cells1_[axis] << (L - 1);
-      if (node_ijk_[n][axis] != plane) continue;
-      (type == BoundaryType::Fixed ? fixed_ : slip_).push_back({std::int64_t(n), face});
-    }
+  std::vector<Level> nodes_of = number_nodes(cpos);
+  if (!add_optional_nodes(cpos, nodes_of, validate)) return false;
+  set_boundary_nodes();
 
   info_.resize(cells_.size());
   cell_lo_.resize(cells_.size());
@@ -441,6 +172,297 @@ bool GradedGrid<D>::build(bool validate) {
   if (!rigid.empty()) rigid.resize(nn);
   built_offset_ = offset_;
   return true;
+}
+
+template <int D>
+void GradedGrid<D>::place_boxes() {
+  // Slab axis: the window's longest (ties to the highest axis), as UniformGrid.
+  slab_ = D - 1;
+  for (int a = D - 2; a >= 0; --a)
+    if (wn_[a] > wn_[slab_]) slab_ = a;
+  std::int64_t st = 1;
+  for (int a = 0; a < D; ++a) stride1_[a] = st, st *= wn_[a];
+  // Box extents at the current offset.
+  for (Box& b : boxes_) {
+    const int s = 1 << (b.level - 1);
+    for (int a = 0; a < D; ++a) {
+      b.xmin[a] = origin_[a] + level_[b.level].h * double(b.lo[a] + offset_[a] * s);
+      b.xmax[a] = origin_[a] + level_[b.level].h * double(b.hi[a] + offset_[a] * s);
+    }
+  }
+}
+
+template <int D>
+bool GradedGrid<D>::clipped(const Box& b, IVec<D>& lo, IVec<D>& hi) const {
+  const int s = 1 << (b.level - 1);
+  lo = (b.lo + offset_ * s).cwiseMax(wlo_ * s);
+  hi = (b.hi + offset_ * s).cwiseMin((wlo_ + wn_) * s);
+  for (int a = 0; a < D; ++a)
+    if (hi[a] <= lo[a]) return false;
+  return true;
+}
+
+template <int D>
+void GradedGrid<D>::build_regions(bool validate) {
+  // Level regions: level 1 is the window; level l the union of its boxes.
+  level_[1].layout(wlo_, wlo_ + wn_);
+  std::fill(level_[1].cell.begin(), level_[1].cell.end(), 0);
+  for (int l = 2; l <= levels_; ++l) {
+    IVec<D> lo = IVec<D>::Constant(std::numeric_limits<int>::max());
+    IVec<D> hi = IVec<D>::Constant(std::numeric_limits<int>::min());
+    bool any = false;
+    for (const Box& b : boxes_)
+      if (b.level == l) {
+        IVec<D> blo, bhi;
+        if (!clipped(b, blo, bhi)) continue;
+        lo = lo.cwiseMin(blo);
+        hi = hi.cwiseMax(bhi);
+        any = true;
+      }
+    if (!any && validate) {
+      for (const Box& b : boxes_)
+        if (b.level > l)
+          fail(b, "level",
+               "a level-" + std::to_string(b.level) + " box needs level-" + std::to_string(l) +
+                   " boxes around it (levels are nested)");
+    }
+    if (!any) lo = hi = IVec<D>::Zero();
+    Level& lv = level_[l];
+    lv.layout(lo, hi);
+    for (const Box& b : boxes_) {
+      IVec<D> blo, bhi;
+      if (b.level == l && clipped(b, blo, bhi))
+        for_cells<D>(blo, bhi, [&](const IVec<D>& c) { lv.cell[lv.index(c)] = 0; });
+    }
+  }
+}
+
+template <int D>
+void GradedGrid<D>::check_nesting() const {
+  // Nesting (each box inside the coarser region) and 2:1 balance: a level-l box (l >= 3)
+  // grown by one level-(l-1) cell on every side must stay inside the level-(l-1) region,
+  // except where it meets the domain's faces, so that cells touching at a face, an edge or a
+  // corner differ by at most one level.
+  for (const Box& b : boxes_) {
+    const int l = b.level;
+    IVec<D> blo, bhi;
+    clipped(b, blo, bhi);
+    const Level& parent = level_[l - 1];
+    const IVec<D> plo = blo / 2, phi = bhi / 2;
+    const auto in_parent = [&](const IVec<D>& lo, const IVec<D>& hi) {
+      bool in = true;
+      for_cells<D>(lo, hi, [&](const IVec<D>& c) {
+        if (!parent.holds(c) || parent.cell[parent.index(c)] == kNotInLevel) in = false;
+      });
+      return in;
+    };
+    if (!in_parent(plo, phi))
+      fail(b, "",
+           "the level-" + std::to_string(l) + " box [" + mm(b.xmin) + ", " + mm(b.xmax) +
+               "] is not inside the level-" + std::to_string(l - 1) +
+               " region (levels are nested)");
+    if (l < 3) continue;
+    IVec<D> glo = plo - IVec<D>::Ones(), ghi = phi + IVec<D>::Ones();
+    const int sp = 1 << (l - 2);
+    for (int a = 0; a < D; ++a) {
+      glo[a] = std::max(glo[a], 0);
+      ghi[a] = std::min(ghi[a], cells1_[a] * sp);
+    }
+    if (!in_parent(glo, ghi))
+      fail(b, "",
+           "the level-" + std::to_string(l) + " box [" + mm(b.xmin) + ", " + mm(b.xmax) +
+               "] comes closer than one level-" + std::to_string(l - 1) + " cell (" +
+               format_mm(parent.h) + " mm) to the edge of the level-" + std::to_string(l - 1) +
+               " region; keep that margin (except at the domain's faces) so that "
+               "neighbouring cells differ by one level at most");
+  }
+}
+
+template <int D>
+void GradedGrid<D>::mark_refined() {
+  // Refined cells: a level-(l-1) cell covered by level-l cells is no leaf.
+  for (int l = levels_; l >= 2; --l)
+    for (const Box& b : boxes_) {
+      IVec<D> blo, bhi;
+      if (b.level != l || !clipped(b, blo, bhi)) continue;
+      Level& parent = level_[l - 1];
+      for_cells<D>(blo / 2, bhi / 2,
+                   [&](const IVec<D>& c) { parent.cell[parent.index(c)] = kRefined; });
+    }
+}
+
+template <int D>
+std::vector<IVec<D>> GradedGrid<D>::number_cells() {
+  // Cell keys: level-1 cells with the slab axis slowest, the leaves inside each depth first;
+  // locate's tree on the way.
+  cells_.clear();
+  std::vector<IVec<D>> cpos;  // leaf position in cells of its level
+  std::size_t refined = 0;
+  for (int l = 1; l < levels_; ++l)
+    refined += std::size_t(std::count(level_[l].cell.begin(), level_[l].cell.end(), kRefined));
+  root_.assign(level_[1].cell.size(), -1);
+  tree_.assign(refined << D, -1);  // sized once: the slots below stay valid
+  std::size_t next = 0;
+  int order[D];
+  int k = 0;
+  for (int a = 0; a < D; ++a)
+    if (a != slab_) order[k++] = a;
+  order[D - 1] = slab_;  // slowest
+  auto visit = [&](auto&& self, int l, const IVec<D>& c, int layer, std::int32_t& slot) -> void {
+    Level& lv = level_[l];
+    const std::int64_t idx = lv.index(c);
+    if (lv.cell[idx] == kRefined) {
+      const std::size_t t = next++;
+      slot = std::int32_t(-1 - std::int64_t(t));
+      for (int bits = 0; bits < kCorners<D>; ++bits) {
+        IVec<D> child;
+        for (int a = 0; a < D; ++a) child[a] = 2 * c[a] + ((bits >> a) & 1);
+        self(self, l + 1, child, layer, tree_[(t << D) + bits]);
+      }
+      return;
+    }
+    Cell cell;
+    cell.level = std::uint8_t(l);
+    cell.layer = layer;
+    slot = lv.cell[idx] = std::int32_t(cells_.size());
+    cells_.push_back(cell);
+    cpos.push_back(c);
+  };
+  IVec<D> c = wlo_;
+  while (true) {
+    std::int64_t idx1 = 0;
+    for (int a = 0; a < D; ++a) idx1 += (c[a] - wlo_[a]) * stride1_[a];
+    visit(visit, 1, c, c[slab_] - wlo_[slab_], root_[idx1]);
+    int q = 0;
+    while (q < D && ++c[order[q]] == wlo_[order[q]] + wn_[order[q]])
+      c[order[q]] = wlo_[order[q]], ++q;
+    if (q == D) break;
+  }
+  return cpos;
+}
+
+template <int D>
+std::int32_t* GradedGrid<D>::node_slot(std::vector<Level>& nodes_of, const IVec<D>& P) const {
+  const int L = levels_;
+  int tz = L - 1;
+  for (int a = 0; a < D; ++a)
+    if (P[a] != 0) tz = std::min(tz, std::countr_zero(unsigned(P[a])));
+  const int k = L - tz;  // the coarsest level whose lattice holds P
+  Level& nl = nodes_of[k];
+  IVec<D> q;
+  for (int a = 0; a < D; ++a) q[a] = P[a] >> (L - k);
+  std::int64_t idx = 0;
+  for (int a = 0; a < D; ++a) {
+    const int c = q[a] - nl.lo[a];
+    if (c < 0 || c >= nl.n[a]) return nullptr;
+    idx += std::int64_t(c) * nl.stride[a];
+  }
+  return &nl.cell[idx];
+}
+
+template <int D>
+std::vector<typename GradedGrid<D>::Level> GradedGrid<D>::number_nodes(
+    const std::vector<IVec<D>>& cpos) {
+  // Nodes: one list for all levels. A node is stored once, at the coarsest level whose
+  // lattice holds it, in a dense array over that level's region (nodes of the bounding box).
+  const int L = levels_;
+  std::vector<Level> nodes_of(L + 1);
+  for (int l = 1; l <= L; ++l) {
+    Level& nl = nodes_of[l];
+    nl.lo = level_[l].lo;
+    nl.n = level_[l].n + IVec<D>::Ones();
+    std::int64_t s = 1;
+    for (int a = 0; a < D; ++a) nl.stride[a] = s, s *= nl.n[a];
+    nl.cell.assign(std::size_t(s), -1);
+  }
+  node_ijk_.clear();
+  for (std::size_t key = 0; key < cells_.size(); ++key) {
+    Cell& cell = cells_[key];
+    const int sh = L - cell.level;
+    for (int c = 0; c < kCorners<D>; ++c) {
+      IVec<D> P;
+      for (int a = 0; a < D; ++a) P[a] = (cpos[key][a] + ((c >> a) & 1)) << sh;
+      std::int32_t* s = node_slot(nodes_of, P);
+      if (!s) throw std::logic_error("graded grid: a corner node lies outside its level's region");
+      if (*s < 0) {
+        *s = std::int32_t(node_ijk_.size());
+        node_ijk_.push_back(P);
+      }
+      cell.corner[c] = *s;
+    }
+  }
+  return nodes_of;
+}
+
+template <int D>
+bool GradedGrid<D>::add_optional_nodes(const std::vector<IVec<D>>& cpos,
+                                       std::vector<Level>& nodes_of, bool validate) {
+  // Optional nodes: the mid-edge and mid-face points of a cell that are corners of finer
+  // cells (hanging nodes), in increasing number (transition_shape.hpp).
+  const int L = levels_;
+  optional_.clear();
+  hanging_.assign(node_ijk_.size(), 0);
+  const TransitionTopology<D>& T = kTransition<D>;
+  std::map<std::uint32_t, double> mask_min;
+  for (std::size_t key = 0; key < cells_.size(); ++key) {
+    Cell& cell = cells_[key];
+    cell.opt = std::uint32_t(optional_.size());
+    if (cell.level == L) continue;
+    const int sh = L - cell.level - 1;  // half a cell, in finest cells: 2^sh
+    for (int k = kCorners<D>; k < kTransitionNodes<D>; ++k) {
+      IVec<D> P;
+      for (int a = 0; a < D; ++a) P[a] = (cpos[key][a] << (sh + 1)) + ((T.p[k][a] + 1) << sh);
+      const std::int32_t* s = node_slot(nodes_of, P);
+      if (!s || *s < 0) continue;
+      cell.mask |= 1u << (k - kCorners<D>);
+      optional_.push_back(*s);
+      hanging_[*s] = 1;
+    }
+    if (cell.mask == 0) continue;
+    auto [it, fresh] = mask_min.try_emplace(cell.mask, 0.0);
+    if (fresh) it->second = transition_min_value<D>(cell.mask);
+    if (it->second < -1e-12 && !validate) return false;  // clipped badly: use a larger window
+    if (it->second < -1e-12) fail_concave(cell, cpos[key]);
+  }
+  return true;
+}
+
+template <int D>
+void GradedGrid<D>::fail_concave(const Cell& cell, const IVec<D>& pos) const {
+  // Name the finer box nearest to the cell.
+  Vec<D> centre;
+  for (int a = 0; a < D; ++a) centre[a] = origin_[a] + level_[cell.level].h * (pos[a] + 0.5);
+  const Box* nearest = &boxes_.front();
+  double best = 1e300;
+  for (const Box& b : boxes_) {
+    if (b.level != cell.level + 1) continue;
+    double d = 0;
+    for (int a = 0; a < D; ++a)
+      d += std::pow(std::max({b.xmin[a] - centre[a], centre[a] - b.xmax[a], 0.0}), 2);
+    if (d < best) best = d, nearest = &b;
+  }
+  fail(*nearest, "",
+       "the level-" + std::to_string(cell.level + 1) + " boxes meet the level-" +
+           std::to_string(cell.level) + " cell at " + mm(centre) +
+           " on two sides (a concave corner); its transition shape functions would be "
+           "negative there. Merge the boxes into one, or keep them at least one level-" +
+           std::to_string(cell.level) + " cell apart");
+}
+
+template <int D>
+void GradedGrid<D>::set_boundary_nodes() {
+  // Boundary conditions on the constrained domain faces (hanging nodes included).
+  fixed_.clear();
+  slip_.clear();
+  for (std::size_t n = 0; n < node_ijk_.size(); ++n)
+    for (int face = 0; face < 2 * D; ++face) {
+      const BoundaryType type = boundary_.face[face];
+      if (type == BoundaryType::Free) continue;
+      const int axis = face / 2;
+      const int plane = face % 2 == 0 ? 0 : cells1_[axis] << (levels_ - 1);
+      if (node_ijk_[n][axis] != plane) continue;
+      (type == BoundaryType::Fixed ? fixed_ : slip_).push_back({std::int64_t(n), face});
+    }
 }
 
 template <int D>

@@ -246,6 +246,26 @@ class GradedGrid {
     IVec<D> lo = IVec<D>::Zero(), n = IVec<D>::Zero();
     std::array<std::int64_t, D> stride{};
     std::vector<std::int32_t> cell;
+    /// Position of cell c (in cells of the level) in `cell`.
+    std::int64_t index(const IVec<D>& c) const {
+      std::int64_t idx = 0;
+      for (int a = 0; a < D; ++a) idx += std::int64_t(c[a] - lo[a]) * stride[a];
+      return idx;
+    }
+    /// True when cell c lies in the region's bounding box.
+    bool holds(const IVec<D>& c) const {
+      for (int a = 0; a < D; ++a)
+        if (c[a] < lo[a] || c[a] >= lo[a] + n[a]) return false;
+      return true;
+    }
+    /// Lays the region over the cells [lo, hi), every one kNotInLevel.
+    void layout(const IVec<D>& lo_cell, const IVec<D>& hi_cell) {
+      lo = lo_cell;
+      n = hi_cell - lo_cell;
+      std::int64_t s = 1;
+      for (int a = 0; a < D; ++a) stride[a] = s, s *= n[a];
+      cell.assign(std::size_t(s), kNotInLevel);
+    }
   };
   static constexpr std::int32_t kNotInLevel = -1, kRefined = -2;
   struct Cell {
@@ -260,6 +280,35 @@ class GradedGrid {
   /// domain), checks the boxes and throws InputError; else returns false when clipping the
   /// boxes to the window would give a transition cell with negative shape functions.
   bool build(bool validate);
+  // The stages of build(), in order:
+  /// The slab axis and strides of the window; the boxes' extents at the current offset.
+  void place_boxes();
+  /// Level 1's region is the window, level l's the union of its boxes clipped to it. With
+  /// `validate`, a level without boxes below a finer level's box fails.
+  void build_regions(bool validate);
+  /// Nesting and 2:1 balance of the boxes (on the whole domain); throws InputError.
+  void check_nesting() const;
+  /// Marks the level-(l-1) cells that level-l cells cover as refined (no leaves).
+  void mark_refined();
+  /// Numbers the leaves (the cell keys) and builds locate's tree; returns each leaf's position
+  /// in cells of its level.
+  std::vector<IVec<D>> number_cells();
+  /// Numbers the corner nodes of the leaves; returns the node arrays of the levels (node_slot).
+  std::vector<Level> number_nodes(const std::vector<IVec<D>>& cpos);
+  /// Finds the optional nodes of the cells (hanging nodes). Returns false when, without
+  /// `validate`, a transition cell would get negative shape functions (fail_concave with it).
+  bool add_optional_nodes(const std::vector<IVec<D>>& cpos, std::vector<Level>& nodes_of,
+                          bool validate);
+  /// The nodes on the constrained domain faces.
+  void set_boundary_nodes();
+  /// The box's cells at the current offset, clipped to the window; false when that is empty.
+  bool clipped(const Box& b, IVec<D>& lo, IVec<D>& hi) const;
+  /// The node slot of a point P (in finest cells) in the node arrays of the levels: at the
+  /// coarsest level whose lattice holds P; nullptr when that level's array does not hold it.
+  std::int32_t* node_slot(std::vector<Level>& nodes_of, const IVec<D>& P) const;
+  /// Fails at the finer box nearest to a transition cell (at position pos in cells of its
+  /// level) whose shape functions would be negative: boxes meeting it on two sides.
+  [[noreturn]] void fail_concave(const Cell& cell, const IVec<D>& pos) const;
   [[noreturn]] void fail(const Box& b, const std::string& key, const std::string& message) const;
   std::string mm(const Vec<D>& x) const;
 

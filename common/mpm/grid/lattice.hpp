@@ -28,9 +28,25 @@ struct Lattice {
   }
 };
 
-/// The lattice of a scene: the given domain, or the bodies' bounding box plus padding, with the
-/// maximum corner rounded up to whole cells. Throws InputError when the cell size is missing,
-/// the domain is empty or would need more than 2^31 cells along an axis.
+/// "x", "y" or "z": the name of axis a (0, 1, 2), for messages.
+inline const char* axis_name(int a) {
+  return a == 0 ? "x" : a == 1 ? "y" : "z";
+}
+
+/// Checks what every lattice of a scene needs: a dimension of 2 or 3 and a positive, finite
+/// cell size (m). Throws InputError naming dimension or grid.cell_size.
+void check_lattice_scene(const Scene& scene);
+
+/// The lattice of a scene whose domain is given (grid.domain, as in every model's scene), with
+/// the maximum corner rounded up to whole cells. Throws InputError when the dimension or the cell
+/// size is bad, no domain is given (mpm-prep fits one around the bodies: fit_lattice in
+/// prep/region.hpp), the domain is empty, or it would need more than 2^31 cells along an axis or
+/// 2^40 in all.
 Lattice make_lattice(const Scene& scene);
+
+/// The lattice of the scene's cell size over the box [lo, hi] (m), with the maximum corner
+/// rounded up to whole cells (at least one cell along each axis). Throws InputError as
+/// make_lattice(scene) does for the dimension, the cell size and the number of cells.
+Lattice make_lattice(const Scene& scene, const Vec3& lo, const Vec3& hi);
 
 }  // namespace mpm

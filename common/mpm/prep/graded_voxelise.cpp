@@ -6,7 +6,7 @@
 
 #include "mpm/core/error.hpp"
 #include "mpm/grid/graded_grid.hpp"
-#include "mpm/prep/mesh_region.hpp"
+#include "mpm/prep/body_placement.hpp"
 #include "mpm/scene/particles.hpp"
 
 namespace mpm {

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "mpm/core/error.hpp"
+#include "mpm/prep/body_placement.hpp"
 
 // Several OpenMP threads query one AABB tree. CGAL guards its lazily built structures only
 // when it knows threads exist; without CGAL_HAS_THREADS it may use unguarded statics.

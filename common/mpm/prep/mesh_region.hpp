@@ -1,29 +1,15 @@
 #pragma once
-/// Private to the voxeliser (voxelise.cpp, mesh_region.cpp): the region of a triangle-mesh
-/// body and the body transform shared with the primitives. CGAL stays inside mesh_region.cpp,
-/// which is the only translation unit that includes it (it compiles slowly).
+/// Private to prep (region.cpp, voxelise.cpp, mesh_region.cpp): the region of a triangle-mesh
+/// body. CGAL stays inside mesh_region.cpp, which is the only translation unit that includes it
+/// (it compiles slowly).
+#include <cstddef>
 #include <memory>
-#include <string>
 
 #include "mpm/core/types.hpp"
-#include "mpm/prep/voxelise.hpp"
+#include "mpm/prep/region.hpp"
 #include "mpm/scene/scene.hpp"
 
 namespace mpm {
-
-/// Rotation of a body: about x, then y, then z, by rotate_deg (degrees); R = Rz Ry Rx.
-Mat3 body_rotation(const BodySpec& body);
-
-/// The linear part of a body's placement, x_world = A x_local + translate, with A = R S
-/// (scale applied first, then the rotation).
-Mat3 body_linear_map(const BodySpec& body);
-
-/// "bodies.<name>.<field>" located at the body's scene line, for InputError.
-std::string body_where(const Scene& scene, const BodySpec& body, const std::string& field);
-
-/// The mesh file of a body as a path to open: absolute paths as given, relative paths from
-/// the scene's directory.
-std::string resolve_mesh_path(const BodySpec& body, const Scene& scene);
 
 /// A closed triangle mesh placed in the world. The file is read with CGAL (STL ASCII or binary,
 /// OFF, OBJ), repaired (duplicate vertices merged), oriented, triangulated, and checked: it must

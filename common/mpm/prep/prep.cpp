@@ -14,6 +14,7 @@
 #include "mpm/grid/lattice.hpp"
 #include "mpm/grid/sparse_grid.hpp"
 #include "mpm/prep/graded_voxelise.hpp"
+#include "mpm/prep/region.hpp"
 #include "mpm/prep/voxelise.hpp"
 #include "mpm/scene/particles.hpp"
 #include "mpm/solver/materials/material.hpp"
@@ -58,57 +59,53 @@ std::string mm(double x) {
   return b;
 }
 
-}  // namespace
+/// What mpm-prep estimates of a run: its first stable step, its steps and its memory.
+struct Estimates {
+  double speed = 0;           ///< fastest signal, m/s (behind the impact shock when faster)
+  double speed_start = 0;     ///< fastest signal at the start, c + |v|, m/s
+  double dt = 0;              ///< first stable step, s
+  double steps = 0;           ///< steps to solver.end_time
+  double bytes_particle = 0;  ///< memory of a particle, bytes
+  double bytes_grid = 0;      ///< memory of the grid (window, sparse or graded), bytes
+};
 
-int prepare_model(const PrepOptions& opt) {
-  const double t0 = omp_get_wtime();
-  Scene scene = load_scene(opt.scene, opt.overrides);
-  const Lattice lattice = make_lattice(scene);
-  std::vector<BodyReport> report;
-  std::optional<GradedModel> graded;  // scenes with grid levels (004, section 3.2)
-  if (!scene.grid.levels.empty()) graded = prepare_graded(scene, lattice, report);
-  ColumnStore cols = graded ? std::move(graded->columns) : voxelise(scene, lattice, report);
-  const double h_min = graded ? graded->h_min : lattice.h;  // the time step's cell
-  const std::string text = with_explicit_domain(scene.toml, lattice);
-
-  // Estimates: first stable step, steps to the end, memory of a run. The signal speed is the
-  // larger of the unshocked c + |v| and, for impacts, the speed behind the shock the fastest
-  // particle of each material drives into like material at rest (u_p = |v| / 2), where the
-  // compressed, heated material carries faster waves and the bulk viscosity widens them: at
-  // hypervelocity that is what sets the step (V4: twice the unshocked estimate).
+/// The signal speeds of the particles (m/s). The signal speed is the larger of the unshocked
+/// c + |v| and, for impacts, the speed behind the shock the fastest particle of each material
+/// drives into like material at rest (u_p = |v| / 2), where the compressed, heated material
+/// carries faster waves and the bulk viscosity widens them: at hypervelocity that is what sets
+/// the step (V4: twice the unshocked estimate).
+void signal_speeds(const Scene& scene, const ColumnStore& cols, Estimates& e) {
   double speed = 0, speed_start = 0;
-  {
-    std::vector<Material> materials;
-    std::vector<double> c(scene.materials.size()), v_max(scene.materials.size(), 0.0);
-    for (std::size_t k = 0; k < c.size(); ++k) {
-      materials.emplace_back(scene.materials[k], scene.solver);
-      c[k] = materials[k].reference_wave_speed();
-    }
-    const auto* mat = cols.get<std::uint8_t>(col::material);
-    const auto* v = reinterpret_cast<const double*>(cols.at(col::v).data());
-    const int d = scene.dimension;
-    for (std::size_t i = 0; i < cols.size(); ++i) {
-      double s2 = 0;
-      for (int a = 0; a < d; ++a) s2 += v[i * d + a] * v[i * d + a];
-      // Rigid bodies (kRigidMaterial) carry no waves: only their speed counts.
-      const double ci = mat[i] == kRigidMaterial ? 0.0 : c[mat[i]];
-      speed_start = std::max(speed_start, ci + std::sqrt(s2));
-      if (mat[i] != kRigidMaterial) v_max[mat[i]] = std::max(v_max[mat[i]], std::sqrt(s2));
-    }
-    speed = speed_start;
-    if (scene.solver.type == SolverType::Explicit)
-      for (std::size_t k = 0; k < c.size(); ++k)
-        if (v_max[k] > 0)
-          speed = std::max(speed, materials[k].shocked_signal_speed(0.5 * v_max[k]));
+  std::vector<Material> materials;
+  std::vector<double> c(scene.materials.size()), v_max(scene.materials.size(), 0.0);
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    materials.emplace_back(scene.materials[k], scene.solver);
+    c[k] = materials[k].reference_wave_speed();
   }
-  const double dt = std::min(scene.solver.dt_max, scene.solver.cfl * h_min / speed);
-  const double steps = std::ceil(scene.solver.end_time / dt);
-  const ColumnNeeds need = column_needs(scene);
+  const auto* mat = cols.get<std::uint8_t>(col::material);
+  const auto* v = reinterpret_cast<const double*>(cols.at(col::v).data());
   const int d = scene.dimension;
-  const double bytes_particle = 2 * d * 8 + 3 * 8 + 48 + 4 + 1 + 1 + (need.eps_p ? 8 : 0) +
-                                (need.T ? 8 : 0) + (need.failed ? 1 : 0) +
-                                (d == 2 && scene.plane_stress ? 8 : 0);  // thickness
-  // Grid window around the bodies: cells of the particles' bounding box, 8 + 3 d 8 bytes a node.
+  for (std::size_t i = 0; i < cols.size(); ++i) {
+    double s2 = 0;
+    for (int a = 0; a < d; ++a) s2 += v[i * d + a] * v[i * d + a];
+    // Rigid bodies (kRigidMaterial) carry no waves: only their speed counts.
+    const double ci = mat[i] == kRigidMaterial ? 0.0 : c[mat[i]];
+    speed_start = std::max(speed_start, ci + std::sqrt(s2));
+    if (mat[i] != kRigidMaterial) v_max[mat[i]] = std::max(v_max[mat[i]], std::sqrt(s2));
+  }
+  speed = speed_start;
+  if (scene.solver.type == SolverType::Explicit)
+    for (std::size_t k = 0; k < c.size(); ++k)
+      if (v_max[k] > 0) speed = std::max(speed, materials[k].shocked_signal_speed(0.5 * v_max[k]));
+  e.speed = speed;
+  e.speed_start = speed_start;
+}
+
+/// Memory of the grid at the start (bytes): the graded grid's nodes, the sparse grid, or the
+/// window around the bodies (cells of the particles' bounding box), 8 + 3 d 8 bytes a node.
+double grid_bytes(const Scene& scene, const Lattice& lattice, const ColumnStore& cols,
+                  const GradedModel* graded) {
+  const int d = scene.dimension;
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
   {
     const auto* x = reinterpret_cast<const double*>(cols.at(col::x).data());
@@ -123,75 +120,109 @@ int prepare_model(const PrepOptions& opt) {
   if (scene.grid.sparse)
     bytes_grid = d == 3 ? sparse_grid_bytes<3>(scene, lattice, cols)
                         : sparse_grid_bytes<2>(scene, lattice, cols);
+  return bytes_grid;
+}
 
-  if (!opt.quiet) {
-    std::fprintf(
-        stderr, "mpm-prep: %s%s%s (%dD%s)\n", scene.source.c_str(), scene.title.empty() ? "" : ": ",
-        scene.title.c_str(), d,
-        d == 2 ? (scene.axisymmetric   ? ", axisymmetric, masses per radian"
-                  : scene.plane_stress ? ", plane stress, masses per metre of initial thickness"
-                                       : ", plane strain, masses per metre")
-               : "");
-    std::fprintf(stderr, "  grid: cell %s mm, domain [%s, %s] x [%s, %s]", mm(lattice.h).c_str(),
-                 mm(lattice.origin[0]).c_str(), mm(lattice.max()[0]).c_str(),
-                 mm(lattice.origin[1]).c_str(), mm(lattice.max()[1]).c_str());
-    if (d == 3)
-      std::fprintf(stderr, " x [%s, %s]", mm(lattice.origin[2]).c_str(),
-                   mm(lattice.max()[2]).c_str());
-    std::fprintf(stderr, " mm, %d x %d", lattice.cells[0], lattice.cells[1]);
-    if (d == 3) std::fprintf(stderr, " x %d", lattice.cells[2]);
-    std::fprintf(stderr, " cells\n");
-    if (graded) {
-      std::fprintf(stderr, "  graded grid: %zu nodes (%zu hanging), %zu transition cells\n",
-                   graded->nodes, graded->hanging_nodes, graded->transition_cells);
-      for (std::size_t l = 1; l < graded->cells.size(); ++l)
-        std::fprintf(stderr, "    level %zu: cell %s mm, %zu cells, %zu particles\n", l,
-                     mm(std::ldexp(lattice.h, -int(l - 1))).c_str(), graded->cells[l],
-                     graded->particles[l]);
-    }
-    std::fprintf(stderr, "  %-14s %-12s %12s %10s %14s %14s %8s\n", "body", "material", "particles",
-                 "spacing", "mass kg", "exact kg", "error");
-    std::size_t total = 0;
-    for (std::size_t b = 0; b < report.size(); ++b) {
-      const BodyReport& r = report[b];
-      total += r.particles;
-      std::fprintf(stderr, "  %-14s %-12s %12zu %7s mm %14.6g %14.6g %7.2f%%\n", r.name.c_str(),
-                   scene.bodies[b].rigid ? "(rigid)"
-                                         : scene.materials[scene.bodies[b].material].name.c_str(),
-                   r.particles, mm(r.spacing).c_str(), r.mass, r.exact_mass,
-                   r.exact_mass > 0 ? 100.0 * (r.mass - r.exact_mass) / r.exact_mass : 0.0);
-      if (r.skipped_overlap > 0)
-        std::fprintf(stderr, "  (body '%s': %zu points inside earlier bodies were not created)\n",
-                     r.name.c_str(), r.skipped_overlap);
-    }
-    std::fprintf(stderr, "  %-14s %-12s %12zu\n", "total", "", total);
-    if (speed > speed_start * (1 + 1e-9))
-      std::fprintf(stderr,
-                   "  time step: about %.4g ns (cfl %g, fastest signal %.0f m/s behind the impact "
-                   "shock, %.0f m/s at the start), about %.0f steps to %.4g us\n",
-                   dt * 1e9, scene.solver.cfl, speed, speed_start, steps,
-                   scene.solver.end_time * 1e6);
-    else
-      std::fprintf(stderr,
-                   "  time step: about %.4g ns (cfl %g, fastest signal c + |v| = %.0f m/s), about "
-                   "%.0f steps to %.4g us\n",
-                   dt * 1e9, scene.solver.cfl, speed, steps, scene.solver.end_time * 1e6);
-    std::fprintf(stderr,
-                 "  memory of a run: about %.0f bytes a particle, %.1f MB for particles and %.1f "
-                 "MB for the grid %s; %.3g million particle-steps\n",
-                 bytes_particle, bytes_particle * double(total) / 1e6, bytes_grid / 1e6,
-                 scene.grid.sparse ? "(sparse, at the start)" : "window",
-                 double(total) * steps / 1e6);
-    if (scene.solver.cfl > 1.0)
-      std::fprintf(stderr, "  warning: solver.cfl = %g exceeds 1; explicit MPM is then unstable\n",
-                   scene.solver.cfl);
-    if (steps > 1e8 && scene.solver.type == SolverType::Explicit)
-      std::fprintf(stderr,
-                   "  warning: about %.3g explicit steps; check the materials' density and moduli, "
-                   "grid.cell_size, solver.dt_max and solver.end_time\n",
-                   steps);
+/// Estimates of a run of the model: first stable step, steps to the end, memory.
+Estimates estimate_run(const Scene& scene, const Lattice& lattice, const ColumnStore& cols,
+                       const GradedModel* graded) {
+  Estimates e;
+  signal_speeds(scene, cols, e);
+  const double h_min = graded ? graded->h_min : lattice.h;  // the time step's cell
+  e.dt = std::min(scene.solver.dt_max, scene.solver.cfl * h_min / e.speed);
+  e.steps = std::ceil(scene.solver.end_time / e.dt);
+  const ColumnNeeds need = column_needs(scene);
+  const int d = scene.dimension;
+  e.bytes_particle = 2 * d * 8 + 3 * 8 + 48 + 4 + 1 + 1 + (need.eps_p ? 8 : 0) + (need.T ? 8 : 0) +
+                     (need.failed ? 1 : 0) + (d == 2 && scene.plane_stress ? 8 : 0);  // thickness
+  e.bytes_grid = grid_bytes(scene, lattice, cols, graded);
+  return e;
+}
+
+/// The summary's head: the scene, its lattice and, for a graded grid, its levels.
+void print_grid(const Scene& scene, const Lattice& lattice, const GradedModel* graded) {
+  const int d = scene.dimension;
+  std::fprintf(stderr, "mpm-prep: %s%s%s (%dD%s)\n", scene.source.c_str(),
+               scene.title.empty() ? "" : ": ", scene.title.c_str(), d,
+               d == 2
+                   ? (scene.axisymmetric   ? ", axisymmetric, masses per radian"
+                      : scene.plane_stress ? ", plane stress, masses per metre of initial thickness"
+                                           : ", plane strain, masses per metre")
+                   : "");
+  std::fprintf(stderr, "  grid: cell %s mm, domain [%s, %s] x [%s, %s]", mm(lattice.h).c_str(),
+               mm(lattice.origin[0]).c_str(), mm(lattice.max()[0]).c_str(),
+               mm(lattice.origin[1]).c_str(), mm(lattice.max()[1]).c_str());
+  if (d == 3)
+    std::fprintf(stderr, " x [%s, %s]", mm(lattice.origin[2]).c_str(),
+                 mm(lattice.max()[2]).c_str());
+  std::fprintf(stderr, " mm, %d x %d", lattice.cells[0], lattice.cells[1]);
+  if (d == 3) std::fprintf(stderr, " x %d", lattice.cells[2]);
+  std::fprintf(stderr, " cells\n");
+  if (graded) {
+    std::fprintf(stderr, "  graded grid: %zu nodes (%zu hanging), %zu transition cells\n",
+                 graded->nodes, graded->hanging_nodes, graded->transition_cells);
+    for (std::size_t l = 1; l < graded->cells.size(); ++l)
+      std::fprintf(stderr, "    level %zu: cell %s mm, %zu cells, %zu particles\n", l,
+                   mm(std::ldexp(lattice.h, -int(l - 1))).c_str(), graded->cells[l],
+                   graded->particles[l]);
   }
+}
 
+/// The summary's table of bodies; returns the particles in all.
+std::size_t print_bodies(const Scene& scene, const std::vector<BodyReport>& report) {
+  std::fprintf(stderr, "  %-14s %-12s %12s %10s %14s %14s %8s\n", "body", "material", "particles",
+               "spacing", "mass kg", "exact kg", "error");
+  std::size_t total = 0;
+  for (std::size_t b = 0; b < report.size(); ++b) {
+    const BodyReport& r = report[b];
+    total += r.particles;
+    std::fprintf(
+        stderr, "  %-14s %-12s %12zu %7s mm %14.6g %14.6g %7.2f%%\n", r.name.c_str(),
+        scene.bodies[b].rigid ? "(rigid)" : scene.materials[scene.bodies[b].material].name.c_str(),
+        r.particles, mm(r.spacing).c_str(), r.mass, r.exact_mass,
+        r.exact_mass > 0 ? 100.0 * (r.mass - r.exact_mass) / r.exact_mass : 0.0);
+    if (r.skipped_overlap > 0)
+      std::fprintf(stderr, "  (body '%s': %zu points inside earlier bodies were not created)\n",
+                   r.name.c_str(), r.skipped_overlap);
+  }
+  std::fprintf(stderr, "  %-14s %-12s %12zu\n", "total", "", total);
+  return total;
+}
+
+/// The summary's estimates of a run of `total` particles, and warnings.
+void print_estimates(const Scene& scene, const Estimates& e, std::size_t total) {
+  if (e.speed > e.speed_start * (1 + 1e-9))
+    std::fprintf(stderr,
+                 "  time step: about %.4g ns (cfl %g, fastest signal %.0f m/s behind the impact "
+                 "shock, %.0f m/s at the start), about %.0f steps to %.4g us\n",
+                 e.dt * 1e9, scene.solver.cfl, e.speed, e.speed_start, e.steps,
+                 scene.solver.end_time * 1e6);
+  else
+    std::fprintf(stderr,
+                 "  time step: about %.4g ns (cfl %g, fastest signal c + |v| = %.0f m/s), about "
+                 "%.0f steps to %.4g us\n",
+                 e.dt * 1e9, scene.solver.cfl, e.speed, e.steps, scene.solver.end_time * 1e6);
+  std::fprintf(stderr,
+               "  memory of a run: about %.0f bytes a particle, %.1f MB for particles and %.1f "
+               "MB for the grid %s; %.3g million particle-steps\n",
+               e.bytes_particle, e.bytes_particle * double(total) / 1e6, e.bytes_grid / 1e6,
+               scene.grid.sparse ? "(sparse, at the start)" : "window",
+               double(total) * e.steps / 1e6);
+  if (scene.solver.cfl > 1.0)
+    std::fprintf(stderr, "  warning: solver.cfl = %g exceeds 1; explicit MPM is then unstable\n",
+                 scene.solver.cfl);
+  if (e.steps > 1e8 && scene.solver.type == SolverType::Explicit)
+    std::fprintf(stderr,
+                 "  warning: about %.3g explicit steps; check the materials' density and moduli, "
+                 "grid.cell_size, solver.dt_max and solver.end_time\n",
+                 e.steps);
+}
+
+/// Writes the model stream: the scene `text`, the info (tool, version, seconds since t0, the
+/// bodies), the GRID record of a graded grid, and the particles.
+void write_model(const PrepOptions& opt, const Scene& scene, const std::string& text,
+                 const std::vector<BodyReport>& report, const GradedModel* graded, ColumnStore cols,
+                 double t0) {
   std::vector<std::string> inputs{opt.scene};
   for (const auto& b : scene.bodies)
     if (!b.mesh_path.empty()) inputs.push_back(b.mesh_path);
@@ -213,6 +244,27 @@ int prepare_model(const PrepOptions& opt) {
   out.write_frame(frame);
   out.write_end(0, "model");
   out.close();
+}
+
+}  // namespace
+
+int prepare_model(const PrepOptions& opt) {
+  const double t0 = omp_get_wtime();
+  Scene scene = load_scene(opt.scene, opt.overrides);
+  const Lattice lattice = fit_lattice(scene);
+  std::vector<BodyReport> report;
+  std::optional<GradedModel> graded;  // scenes with grid levels (004, section 3.2)
+  if (!scene.grid.levels.empty()) graded = prepare_graded(scene, lattice, report);
+  ColumnStore cols = graded ? std::move(graded->columns) : voxelise(scene, lattice, report);
+  const GradedModel* graded_grid = graded ? &*graded : nullptr;
+  const std::string text = with_explicit_domain(scene.toml, lattice);
+  const Estimates estimates = estimate_run(scene, lattice, cols, graded_grid);
+  if (!opt.quiet) {
+    print_grid(scene, lattice, graded_grid);
+    const std::size_t total = print_bodies(scene, report);
+    print_estimates(scene, estimates, total);
+  }
+  write_model(opt, scene, text, report, graded_grid, std::move(cols), t0);
   return kExitOk;
 }
 

@@ -3,11 +3,10 @@
 /// at cell-aligned positions (cell corner + (i + 1/2) h / n) that lie inside the body, or, with
 /// particle_spacing s, the points inside it of a lattice of spacing s centred on its bounding
 /// box (round(L / s) points along each extent L), whatever the cells.
-/// Primitives use exact inside tests; meshes (STL, OFF, OBJ) use CGAL's Side_of_triangle_mesh
-/// on an AABB tree and must be closed.
+/// Primitives use exact inside tests (region.hpp); meshes (STL, OFF, OBJ) use CGAL's
+/// Side_of_triangle_mesh on an AABB tree and must be closed (mesh_region.hpp).
 #include <array>
 #include <functional>
-#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,28 +15,6 @@
 #include "mpm/scene/scene.hpp"
 
 namespace mpm {
-
-/// A body's region in world coordinates (after scale, rotation, translation).
-class Region {
- public:
-  virtual ~Region() = default;
-  /// True when x (m) is inside (points exactly on the surface may go either way).
-  virtual bool contains(const Vec3& x) const = 0;
-  /// Exact volume (m^3; in 2D the area in m^2): analytic for primitives, the closed mesh's
-  /// signed volume for meshes.
-  virtual double volume() const = 0;
-  /// Axisymmetric 2D scenes: the volume per radian of the solid of revolution about the y
-  /// axis swept by the part of the region at x >= 0, the integral of x over that part (m^3).
-  /// Exact for the 2D primitives (rectangles, disks and their rotated, scaled images).
-  virtual double revolved_volume() const;
-  /// World-space bounding box.
-  virtual void bounds(Vec3& lo, Vec3& hi) const = 0;
-};
-
-/// The region of a body. Reads and checks the mesh file for meshes.
-/// Throws InputError naming the body's scene key and the file when the mesh cannot be read,
-/// is empty, or is not closed.
-std::unique_ptr<Region> make_region(const BodySpec& body, const Scene& scene);
 
 /// What voxelisation produced for one body.
 struct BodyReport {

@@ -1,0 +1,266 @@
+// Bodies' regions: the primitives (box, cylinder, sphere; rectangle and disk in 2D) with exact
+// inside tests and volumes, the checks of a body's shape and placement, and the lattice fitted
+// around the bodies. Mesh regions (CGAL) live in mesh_region.cpp.
+#include "mpm/prep/region.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "mpm/core/error.hpp"
+#include "mpm/core/units.hpp"
+#include "mpm/prep/body_placement.hpp"
+#include "mpm/prep/mesh_region.hpp"
+
+namespace mpm {
+
+namespace {
+
+const char* shape_name(ShapeKind k) {
+  switch (k) {
+    case ShapeKind::Box:
+      return "box";
+    case ShapeKind::Cylinder:
+      return "cylinder";
+    case ShapeKind::Sphere:
+      return "sphere";
+    case ShapeKind::Mesh:
+      return "mesh";
+  }
+  return "?";
+}
+
+bool finite(const Vec3& v) {
+  return v.allFinite();
+}
+
+/// Box, cylinder and sphere (rectangle and disk in 2D). contains() maps the point back to the
+/// local frame with the precomputed inverse placement, x_local = S^-1 R^T (x - t), and tests
+/// the local shape exactly.
+class PrimitiveRegion final : public Region {
+ public:
+  PrimitiveRegion(const BodySpec& body, int dim) : kind_(body.shape), dim_(dim) {
+    Mat3 A = body_linear_map(body);
+    Vec3 s = body.scale;
+    t_ = body.translate;
+    if (dim == 2) {
+      // x-y plane only: no z scale, no z translation.
+      A.row(2).setZero();
+      A.col(2).setZero();
+      A(2, 2) = 1;
+      s.z() = 1;
+      t_.z() = 0;
+    }
+    to_local_ = s.cwiseInverse().asDiagonal() * body_rotation(body).transpose();
+    A_ = A;
+    const double ascale = std::abs(s.x() * s.y() * s.z());
+    r2_ = body.radius * body.radius;
+    half_ = 0.5 * body.size;
+    length_ = body.length;
+    const double pi = std::numbers::pi;
+    switch (kind_) {
+      case ShapeKind::Box: {
+        // Half extent along world axis a: sum_j |A_aj| half_j.
+        Vec3 h = half_;
+        if (dim == 2) h.z() = 0;
+        const Vec3 e = A.cwiseAbs() * h;
+        lo_ = t_ - e;
+        hi_ = t_ + e;
+        volume_ = (dim == 2 ? body.size.x() * body.size.y() : body.size.prod()) * ascale;
+        break;
+      }
+      case ShapeKind::Sphere: {
+        // Ellipsoid {A u + t : |u| <= r}: half extent along a is r |row a of A|.
+        Vec3 e;
+        for (int a = 0; a < 3; ++a) e[a] = body.radius * A.row(a).norm();
+        if (dim == 2) e.z() = 0;
+        lo_ = t_ - e;
+        hi_ = t_ + e;
+        volume_ = (dim == 2 ? pi * r2_ : 4.0 / 3.0 * pi * r2_ * body.radius) * ascale;
+        break;
+      }
+      case ShapeKind::Cylinder: {
+        // Union of the end disks' boxes: a disk {A (u, v, 0) + c : u^2 + v^2 <= r^2} has half
+        // extent r sqrt(A_a0^2 + A_a1^2) along a.
+        Vec3 e;
+        for (int a = 0; a < 3; ++a) e[a] = body.radius * std::hypot(A(a, 0), A(a, 1));
+        const Vec3 top = t_ + A * Vec3(0, 0, body.length);
+        lo_ = t_.cwiseMin(top) - e;
+        hi_ = t_.cwiseMax(top) + e;
+        volume_ = pi * r2_ * body.length * ascale;
+        break;
+      }
+      case ShapeKind::Mesh:
+        break;  // not a primitive
+    }
+  }
+
+  bool contains(const Vec3& x) const override {
+    const Vec3 p = to_local_ * (x - t_);
+    switch (kind_) {
+      case ShapeKind::Box:
+        return std::abs(p.x()) <= half_.x() && std::abs(p.y()) <= half_.y() &&
+               (dim_ == 2 || std::abs(p.z()) <= half_.z());
+      case ShapeKind::Sphere:
+        return (dim_ == 2 ? p.x() * p.x() + p.y() * p.y() : p.squaredNorm()) <= r2_;
+      case ShapeKind::Cylinder:
+        return p.z() >= 0 && p.z() <= length_ && p.x() * p.x() + p.y() * p.y() <= r2_;
+      case ShapeKind::Mesh:
+        return false;
+    }
+    return false;
+  }
+  double volume() const override { return volume_; }
+  void bounds(Vec3& lo, Vec3& hi) const override {
+    lo = lo_;
+    hi = hi_;
+  }
+
+  double revolved_volume() const override {
+    if (dim_ != 2) return Region::revolved_volume();
+    if (kind_ == ShapeKind::Sphere) {
+      // The ellipse {A u + t : |u| <= R}: x = a.u + t_x with a the first row of A. With w the
+      // coordinate of u along a, the integral of x over x >= 0 is |det A| times the integral
+      // of (|a| w + t_x) 2 sqrt(R^2 - w^2) over w from max(-R, -t_x / |a|) to R.
+      const double detA = std::abs(A_(0, 0) * A_(1, 1) - A_(0, 1) * A_(1, 0));
+      const double R = std::sqrt(r2_), alpha = std::hypot(A_(0, 0), A_(0, 1));
+      const double w0 = std::clamp(-t_.x() / alpha, -R, R);
+      auto root = [&](double w) {
+        return std::sqrt(std::max(0.0, (R - w) * (R + w)));
+      };                        // 0 at w = +-R
+      auto F = [&](double w) {  // of 2 sqrt(R^2 - w^2)
+        return w * root(w) + R * R * std::asin(std::clamp(w / R, -1.0, 1.0));
+      };
+      auto G = [&](double w) {
+        return -2.0 / 3.0 * std::pow(root(w), 3);
+      };  // of 2 w sqrt(R^2 - w^2)
+      return detA * (t_.x() * (F(R) - F(w0)) + alpha * (G(R) - G(w0)));
+    }
+    // The parallelogram of the box's corners, clipped to x >= 0 (one half-plane of
+    // Sutherland-Hodgman); its integral of x by the polygon formula
+    // (1/6) sum (x_i + x_j) (x_i y_j - x_j y_i), j = i + 1.
+    std::vector<Vec<2>> in, out;
+    for (const auto& [i, j] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}) {
+      const Vec3 c = A_ * Vec3(i * half_.x(), j * half_.y(), 0) + t_;
+      in.emplace_back(c.x(), c.y());
+    }
+    for (std::size_t k = 0; k < in.size(); ++k) {
+      const Vec<2>&p = in[k], &q = in[(k + 1) % in.size()];
+      if (p.x() >= 0) out.push_back(p);
+      if ((p.x() >= 0) != (q.x() >= 0))
+        out.emplace_back(0.0, p.y() + (q.y() - p.y()) * (0 - p.x()) / (q.x() - p.x()));
+    }
+    double moment = 0;
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      const Vec<2>&p = out[k], &q = out[(k + 1) % out.size()];
+      moment += (p.x() + q.x()) * (p.x() * q.y() - q.x() * p.y());
+    }
+    return std::abs(moment) / 6.0;
+  }
+
+ private:
+  ShapeKind kind_;
+  int dim_;
+  Mat3 A_;
+  Mat3 to_local_;
+  Vec3 t_, half_, lo_, hi_;
+  double r2_ = 0, length_ = 0, volume_ = 0;
+};
+
+/// Checks a body's shape parameters and placement; throws InputError at the offending key.
+void check_body_shape(const BodySpec& body, const Scene& scene) {
+  const int dim = scene.dimension;
+  if (dim == 2 && (body.shape == ShapeKind::Cylinder || body.shape == ShapeKind::Mesh))
+    throw InputError(body_where(scene, body, "shape"),
+                     "body '" + body.name + "' is a " + shape_name(body.shape) +
+                         "; a 2D scene takes only box (a rectangle) and sphere (a disk)");
+  for (int a = 0; a < dim; ++a)
+    if (!(body.scale[a] != 0) || !std::isfinite(body.scale[a]))
+      throw InputError(body_where(scene, body, "scale"),
+                       std::string("the scale along ") + axis_name(a) +
+                           " must be a non-zero number (got " + format_g6(body.scale[a]) + ")");
+  if (!finite(body.rotate_deg))
+    throw InputError(body_where(scene, body, "rotate_deg"), "the rotation must be finite");
+  if (!finite(body.translate))
+    throw InputError(body_where(scene, body, "translate"), "the translation must be finite");
+  if (dim == 2 && (body.rotate_deg.x() != 0 || body.rotate_deg.y() != 0))
+    throw InputError(body_where(scene, body, "rotate_deg"),
+                     "a 2D scene rotates bodies only about z; the x and y angles must be 0");
+  switch (body.shape) {
+    case ShapeKind::Box:
+      for (int a = 0; a < dim; ++a)
+        if (!(body.size[a] > 0) || !std::isfinite(body.size[a]))
+          throw InputError(body_where(scene, body, "size"),
+                           std::string("the box's edge along ") + axis_name(a) +
+                               " must be a positive length in m (got " + format_g6(body.size[a]) +
+                               ")");
+      break;
+    case ShapeKind::Cylinder:
+      if (!(body.length > 0) || !std::isfinite(body.length))
+        throw InputError(
+            body_where(scene, body, "length"),
+            "the cylinder's length must be positive, in m (got " + format_g6(body.length) + ")");
+      [[fallthrough]];
+    case ShapeKind::Sphere:
+      if (!(body.radius > 0) || !std::isfinite(body.radius))
+        throw InputError(
+            body_where(scene, body, "radius"),
+            "the radius must be a positive length in m (got " + format_g6(body.radius) + ")");
+      break;
+    case ShapeKind::Mesh:
+      break;  // checked when the file is read
+  }
+}
+
+/// World bounding box of a body (reads mesh files but does not build their trees).
+void body_bounds(const BodySpec& body, const Scene& scene, Vec3& lo, Vec3& hi) {
+  check_body_shape(body, scene);
+  if (body.shape == ShapeKind::Mesh) {
+    mesh_body_bounds(body, scene, lo, hi);
+  } else {
+    PrimitiveRegion(body, scene.dimension).bounds(lo, hi);
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<Region> make_region(const BodySpec& body, const Scene& scene) {
+  check_body_shape(body, scene);
+  if (body.shape == ShapeKind::Mesh) return std::make_unique<MeshRegion>(body, scene);
+  return std::make_unique<PrimitiveRegion>(body, scene.dimension);
+}
+
+Lattice fit_lattice(const Scene& scene) {
+  const GridSpec& g = scene.grid;
+  if (g.domain_given) return make_lattice(scene);
+  check_lattice_scene(scene);
+  if (!(g.padding >= 0) || !std::isfinite(g.padding))
+    throw InputError(where(scene.source, g.loc.line, "grid.padding"),
+                     "the padding must be a length >= 0 in m (got " + format_g6(g.padding) + ")");
+  if (scene.bodies.empty())
+    throw InputError(where(scene.source, g.loc.line, "grid.domain"),
+                     "no domain is given and there is no body to fit one around");
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 hi = -lo;
+  for (const BodySpec& b : scene.bodies) {
+    Vec3 blo, bhi;
+    body_bounds(b, scene, blo, bhi);
+    lo = lo.cwiseMin(blo);
+    hi = hi.cwiseMax(bhi);
+  }
+  lo.array() -= g.padding;
+  hi.array() += g.padding;
+  return make_lattice(scene, lo, hi);
+}
+
+double Region::revolved_volume() const {
+  throw std::logic_error(
+      "revolved_volume: only the 2D primitives (boxes and disks) sweep a solid of revolution");
+}
+
+}  // namespace mpm

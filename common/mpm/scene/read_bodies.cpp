@@ -1,0 +1,299 @@
+// The scene parser's [[bodies]] (shape, placement, particles, rigid contact) and [[loads]].
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mpm/core/error.hpp"
+#include "mpm/scene/read_sections.hpp"
+
+namespace mpm::scene_toml {
+
+namespace {
+
+using namespace std::string_literals;
+
+bool valid_name(std::string_view s) {
+  if (s.empty()) return false;
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+           c == '-';
+  });
+}
+
+const std::vector<std::string_view> kBodyKeys = {"name",
+                                                 "material",
+                                                 "shape",
+                                                 "size",
+                                                 "radius",
+                                                 "length",
+                                                 "file",
+                                                 "scale",
+                                                 "rotate",
+                                                 "translate",
+                                                 "velocity",
+                                                 "particles_per_cell",
+                                                 "particle_spacing",
+                                                 "rigid",
+                                                 "slip"};
+
+/// The body's material, or none for a rigid body.
+void read_body_material(Reader& r, const Scene& scene, BodySpec& b) {
+  b.rigid = r.boolean("rigid").value_or(false);
+  const auto material = r.string("material");
+  if (b.rigid) {
+    if (material)
+      r.fail("material",
+             "a rigid body has no material (it moves at its velocity whatever happens)");
+  } else if (!material) {
+    r.missing("material", "the name of a material, e.g. \"copper\"");
+  }
+  b.material = material ? scene.material_index(*material) : -1;
+  if (!b.rigid && b.material < 0) {
+    std::vector<std::string_view> known;
+    for (const auto& m : scene.materials) known.push_back(m.name);
+    r.fail("material", "unknown material '" + *material + "' (known: " + join(known) + ")");
+  }
+}
+
+/// The body's shape and the keys that size it (and no key of another shape).
+void read_shape(Reader& r, const Scene& scene, BodySpec& b) {
+  const int n = scene.dimension;
+  const bool two_d = n == 2;
+  const auto shape = r.choice<ShapeKind>("shape", {{"box", ShapeKind::Box},
+                                                   {"cylinder", ShapeKind::Cylinder},
+                                                   {"sphere", ShapeKind::Sphere},
+                                                   {"mesh", ShapeKind::Mesh}});
+  if (!shape) r.missing("shape", "one of \"box\", \"cylinder\", \"sphere\", \"mesh\"");
+  b.shape = *shape;
+  if (two_d && (b.shape == ShapeKind::Cylinder || b.shape == ShapeKind::Mesh)) {
+    r.fail("shape", "shape \"" + *r.string("shape") +
+                        "\" is not available in 2D scenes; use box or sphere (a disk)");
+  }
+  const std::string shape_name = *r.string("shape");
+  const auto not_for = [&](std::string_view applies) {
+    return "with shape = \"" + shape_name + "\" (this key is for " + std::string(applies) + ")";
+  };
+  switch (b.shape) {
+    case ShapeKind::Box:
+      if (auto v = r.vector("size", dim::length, n, Bound::Positive)) {
+        b.size = *v;
+      } else {
+        r.missing("size", two_d ? "edge lengths x y, e.g. \"10 5 mm\""
+                                : "edge lengths x y z, e.g. \"10 10 5 mm\"");
+      }
+      r.reject({"radius"}, not_for("cylinder and sphere"));
+      r.reject({"length"}, not_for("cylinder"));
+      r.reject({"file"}, not_for("mesh"));
+      break;
+    case ShapeKind::Cylinder:
+      b.radius = r.required("radius", dim::length, Bound::Positive, "3.8 mm");
+      b.length = r.required("length", dim::length, Bound::Positive, "25.4 mm");
+      r.reject({"size"}, not_for("box"));
+      r.reject({"file"}, not_for("mesh"));
+      break;
+    case ShapeKind::Sphere:
+      b.radius = r.required("radius", dim::length, Bound::Positive, "3.8 mm");
+      r.reject({"size"}, not_for("box"));
+      r.reject({"length"}, not_for("cylinder"));
+      r.reject({"file"}, not_for("mesh"));
+      break;
+    case ShapeKind::Mesh: {
+      const auto file = r.string("file");
+      if (!file) r.missing("file", "the mesh file (STL, OFF or OBJ), e.g. \"part.stl\"");
+      r.check("file", !file->empty(), "must not be empty");
+      const std::filesystem::path p(*file);
+      b.mesh_path = (p.is_absolute() || scene.directory.empty())
+                        ? p.string()
+                        : (std::filesystem::path(scene.directory) / p).string();
+      r.reject({"size"}, not_for("box"));
+      r.reject({"radius"}, not_for("cylinder and sphere"));
+      r.reject({"length"}, not_for("cylinder"));
+      break;
+    }
+  }
+}
+
+/// Scale, rotation, translation and velocity.
+void read_placement(Reader& r, int n, BodySpec& b) {
+  const bool two_d = n == 2;
+  if (auto v = r.vector("scale", dim::none, n, Bound::Positive, false, true)) b.scale = *v;
+  if (two_d) b.scale.z() = 1.0;
+  if (two_d) {
+    const toml::node* rot = r.get("rotate");
+    if (rot && !(rot->is_integer() || rot->is_floating_point() || rot->is_string())) {
+      r.fail("rotate",
+             "expected a single angle about z in 2D scenes, e.g. \"30 deg\", " + got(*rot));
+    }
+    if (rot && rot->is_string()) {
+      try {
+        (void)parse_quantity(rot->as_string()->get());
+      } catch (const std::invalid_argument& e) {
+        r.fail("rotate",
+               "expected a single angle about z in 2D scenes, e.g. \"30 deg\": "s + e.what());
+      }
+    }
+    if (auto a = r.angle("rotate")) b.rotate_deg = Vec3(0, 0, *a);
+  } else if (auto v = r.vector("rotate", dim::none, 3, Bound::Any, true)) {
+    b.rotate_deg = *v;
+  }
+  if (auto v = r.vector("translate", dim::length, n)) b.translate = *v;
+  if (auto v = r.vector("velocity", dim::velocity, n)) b.velocity = *v;
+}
+
+/// particles_per_cell, or particle_spacing.
+void read_particles(Reader& r, BodySpec& b) {
+  b.particles_per_cell = static_cast<int>(r.integer("particles_per_cell", 1, 8).value_or(2));
+  if (auto sp = r.quantity("particle_spacing", dim::length, Bound::Positive)) {
+    // One or the other (a --set of one removes the other: apply_override).
+    if (r.has("particles_per_cell"))
+      r.fail("particle_spacing",
+             "give either particles_per_cell (the spacing is the cell size over it) or "
+             "particle_spacing, not both");
+    b.particle_spacing = *sp;
+    b.spacing_loc = r.loc_of("particle_spacing");
+  }
+}
+
+/// slip: for rigid bodies only.
+void read_slip(Reader& r, int n, BodySpec& b) {
+  const bool two_d = n == 2;
+  if (auto slip = r.string("slip")) {
+    // The axes along which a rigid body's contact is frictionless: "y", "x z", "xz"; "none":
+    // no-slip (the default, for --set).
+    const std::string axes = two_d ? "x y" : "x y z";
+    if (!b.rigid)
+      r.fail("slip", "only a rigid body has a contact to slip on (this body has a material)");
+    for (char c : *slip == "none" ? std::string() : *slip) {
+      if (c == ' ' || c == ',') continue;
+      const int a = c - 'x';
+      if (a < 0 || a >= n)
+        r.fail("slip", "expected the axes along which the contact is frictionless, from " + axes +
+                           ", e.g. \"y\"; got '" + std::string(1, c) + "' in \"" + *slip + "\"");
+      b.slip_axes |= std::uint8_t(1u << a);
+    }
+    if (b.slip_axes == 0 && *slip != "none")
+      r.fail("slip", "expected at least one axis from " + axes + ", e.g. \"y\", or \"none\"");
+    if (b.slip_axes == (1u << n) - 1)
+      r.fail("slip", "a body that slips along every axis holds nothing; leave one axis out");
+  }
+}
+
+/// One [[bodies]] table.
+BodySpec read_body(Reader& r, const Scene& scene) {
+  BodySpec b;
+  b.name = *r.string("name");
+  b.loc = r.loc();
+  read_body_material(r, scene, b);
+  read_shape(r, scene, b);
+  read_placement(r, scene.dimension, b);
+  read_particles(r, b);
+  read_slip(r, scene.dimension, b);
+  r.finish();
+  return b;
+}
+
+}  // namespace
+
+void read_bodies(Reader& top, Scene& s) {
+  const toml::node* node = top.get("bodies");
+  if (!node) {
+    top.fail("bodies", "missing required array [[bodies]] (at least one body)");
+  }
+  const auto* arr = node->as_array();
+  if (!arr) {
+    top.fail("bodies",
+             "expected an array of tables ([[bodies]], note the double brackets), " + got(*node));
+  }
+  if (arr->empty()) top.fail("bodies", "at least one body is required");
+  const Doc& doc = top.doc();
+  const Origin array_origin = top.origin_of(*node);
+  std::map<std::string, std::string> seen;  // name -> where
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    const toml::node& e = (*arr)[i];
+    const std::string index_path = "bodies[" + std::to_string(i) + "]";
+    const Origin o = doc.origin(e, array_origin);
+    const auto* t = e.as_table();
+    if (!t) throw InputError(doc.where(o, index_path), "expected a table ([[bodies]]), " + got(e));
+    const toml::node* name = t->get("name");
+    if (!name) {
+      throw InputError(doc.where(o, index_path),
+                       "missing required key 'name' (letters, digits, '_' and '-', e.g. \"bar\")");
+    }
+    const Origin name_origin = doc.origin(*name, o);
+    const auto* name_str = name->as_string();
+    if (!name_str) {
+      throw InputError(doc.where(name_origin, index_path + ".name"),
+                       "expected a string, " + got(*name));
+    }
+    if (!valid_name(name_str->get())) {
+      throw InputError(
+          doc.where(name_origin, index_path + ".name"),
+          "a body name may contain only letters, digits, '_' and '-', got " + show(*name));
+    }
+    const std::string path = "bodies." + name_str->get();
+    if (auto it = seen.find(name_str->get()); it != seen.end()) {
+      throw InputError(
+          doc.where(name_origin, path + ".name"),
+          "duplicate body name '" + name_str->get() + "' (first used at " + it->second + ")");
+    }
+    seen[name_str->get()] = doc.where(name_origin, "");
+    Reader r(doc, *t, path, o, kBodyKeys);
+    s.bodies.push_back(read_body(r, s));
+  }
+}
+
+void read_loads(Reader& top, Scene& s) {
+  const toml::node* node = top.get("loads");
+  if (!node) return;
+  const auto* arr = node->as_array();
+  if (!arr) {
+    top.fail("loads",
+             "expected an array of tables ([[loads]], note the double brackets), " + got(*node));
+  }
+  const Doc& doc = top.doc();
+  const Origin array_origin = top.origin_of(*node);
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    const toml::node& e = (*arr)[i];
+    const std::string path = "loads." + std::to_string(i);
+    const Origin o = doc.origin(e, array_origin);
+    const auto* t = e.as_table();
+    if (!t) throw InputError(doc.where(o, path), "expected a table ([[loads]]), " + got(e));
+    Reader r(doc, *t, path, o, {"body", "force", "region"});
+    LoadSpec l;
+    l.loc = r.loc();
+    const auto body = r.string("body");
+    if (!body) r.missing("body", "the name of the body the force acts on, e.g. \"rod\"");
+    l.body = s.body_index(*body);
+    if (l.body < 0) {
+      std::vector<std::string_view> known;
+      for (const auto& b : s.bodies) known.push_back(b.name);
+      r.fail("body", "unknown body '" + *body + "' (known: " + join(known) + ")");
+    }
+    if (s.bodies[l.body].rigid) r.fail("body", "a rigid body cannot carry a load");
+    const auto f = r.vector("force", dim::force, s.dimension);
+    if (!f)
+      r.missing("force", s.dimension == 2 ? "the total force, e.g. \"2.5 0 N\""
+                                          : "the total force, e.g. \"2.5 0 0 N\"");
+    l.force = *f;
+    if (auto reg = r.table("region", {"min", "max"})) {
+      const auto lo = reg->vector("min", dim::length, s.dimension);
+      const auto hi = reg->vector("max", dim::length, s.dimension);
+      if (!lo) reg->missing("min", "the region's minimum corner");
+      if (!hi) reg->missing("max", "the region's maximum corner");
+      for (int a = 0; a < s.dimension; ++a)
+        reg->check("max", (*hi)[a] > (*lo)[a], "must exceed region.min in every component");
+      l.region_given = true;
+      l.region_min = *lo;
+      l.region_max = *hi;
+      reg->finish();
+    }
+    r.finish();
+    s.loads.push_back(l);
+  }
+}
+
+}  // namespace mpm::scene_toml

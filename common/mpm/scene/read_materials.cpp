@@ -1,0 +1,144 @@
+// The scene parser's [materials.<name>] tables: elasticity, strength, equation of state, failure.
+#include <initializer_list>
+#include <string>
+#include <string_view>
+
+#include "mpm/core/error.hpp"
+#include "mpm/scene/read_sections.hpp"
+
+namespace mpm::scene_toml {
+
+namespace {
+
+void read_strength(Reader& r, StrengthSpec& s) {
+  s.model = r.choice<StrengthModel>("model", {{"elastic", StrengthModel::Elastic},
+                                              {"j2", StrengthModel::J2},
+                                              {"johnson-cook", StrengthModel::JohnsonCook}})
+                .value_or(StrengthModel::Elastic);
+  const std::initializer_list<std::string_view> jc_only = {"C",
+                                                           "reference_rate",
+                                                           "m",
+                                                           "room_temperature",
+                                                           "melt_temperature",
+                                                           "specific_heat",
+                                                           "taylor_quinney"};
+  if (s.model == StrengthModel::Elastic) {
+    r.reject({"A", "B", "n"}, "by the elastic model (set model = \"j2\" or \"johnson-cook\")");
+    r.reject(jc_only, "by the elastic model (set model = \"johnson-cook\")");
+    r.finish();
+    return;
+  }
+  s.A = r.required("A", dim::pressure, Bound::NonNegative, "157 MPa");
+  s.B = r.quantity("B", dim::pressure, Bound::NonNegative).value_or(0.0);
+  s.n = r.number("n", Bound::Positive).value_or(1.0);
+  if (s.model == StrengthModel::J2) {
+    r.reject(jc_only, "by the j2 model (only by \"johnson-cook\")");
+    r.finish();
+    return;
+  }
+  s.C = r.number("C", Bound::NonNegative).value_or(0.0);
+  s.reference_rate = r.quantity("reference_rate", dim::rate, Bound::Positive).value_or(1.0);
+  s.m = r.number("m", Bound::NonNegative).value_or(0.0);
+  s.room_temperature =
+      r.quantity("room_temperature", dim::temperature, Bound::Positive).value_or(293.0);
+  if (s.m > 0) {
+    s.melt_temperature = r.required("melt_temperature", dim::temperature, Bound::Positive, "1356 K",
+                                    "required when m > 0");
+    s.specific_heat = r.required("specific_heat", dim::specific_heat, Bound::Positive,
+                                 "383 J/(kg*K)", "required when m > 0");
+  } else {
+    if (auto v = r.quantity("melt_temperature", dim::temperature, Bound::Positive)) {
+      s.melt_temperature = *v;
+    }
+    if (auto v = r.quantity("specific_heat", dim::specific_heat, Bound::Positive)) {
+      s.specific_heat = *v;
+    }
+  }
+  if (r.has("melt_temperature")) {
+    r.check("melt_temperature", s.melt_temperature > s.room_temperature,
+            "must be above room_temperature (" + format_number(s.room_temperature) + " K)");
+  }
+  s.taylor_quinney = r.number("taylor_quinney").value_or(0.9);
+  r.check("taylor_quinney", s.taylor_quinney >= 0 && s.taylor_quinney <= 1,
+          "must be between 0 and 1");
+  r.finish();
+}
+
+void read_eos(Reader& r, EosSpec& e) {
+  e.model = r.choice<EosModel>(
+                 "model", {{"linear", EosModel::Linear}, {"mie-gruneisen", EosModel::MieGruneisen}})
+                .value_or(EosModel::Linear);
+  if (e.model == EosModel::Linear) {
+    r.reject({"c0", "s", "gamma0", "energy_in_expansion"},
+             "by the linear model (set model = \"mie-gruneisen\")");
+  } else {
+    e.c0 = r.required("c0", dim::velocity, Bound::Positive, "3940 m/s");
+    e.s = r.required("s", dim::none, Bound::NonNegative, "1.49");
+    e.gamma0 = r.required("gamma0", dim::none, Bound::NonNegative, "1.96");
+    e.energy_in_expansion = r.boolean("energy_in_expansion").value_or(true);
+  }
+  r.finish();
+}
+
+void read_failure(Reader& r, FailureSpec& f) {
+  if (r.table().empty()) {
+    r.fail_table("empty table: give plastic_strain, pressure or both (or remove the table)");
+  }
+  if (auto v = r.number("plastic_strain", Bound::Positive)) f.plastic_strain = *v;
+  if (auto v = r.quantity("pressure", dim::pressure, Bound::Negative)) f.pressure = *v;
+  r.finish();
+}
+
+MaterialSpec read_material(Reader& r, const std::string& name) {
+  MaterialSpec m;
+  m.name = name;
+  m.loc = r.loc();
+  m.density = r.required("density", dim::density, Bound::Positive, "8930 kg/m^3");
+  m.youngs_modulus = r.required("youngs_modulus", dim::pressure, Bound::Positive, "117 GPa");
+  m.poisson_ratio = r.required("poisson_ratio", dim::none, Bound::Any, "0.35");
+  r.check("poisson_ratio", m.poisson_ratio > -1, "must be above -1");
+  r.check("poisson_ratio", m.poisson_ratio < 0.5,
+          "must be below 0.5 (incompressible materials are not supported)");
+  if (auto t = r.table("strength",
+                       {"model", "A", "B", "n", "C", "reference_rate", "m", "room_temperature",
+                        "melt_temperature", "specific_heat", "taylor_quinney"})) {
+    read_strength(*t, m.strength);
+  }
+  if (auto t = r.table("eos", {"model", "c0", "s", "gamma0", "energy_in_expansion"}))
+    read_eos(*t, m.eos);
+  if (auto t = r.table("failure", {"plastic_strain", "pressure"})) read_failure(*t, m.failure);
+  r.finish();
+  return m;
+}
+
+}  // namespace
+
+void read_materials(Reader& top, Scene& s) {
+  const Doc& doc = top.doc();
+  const toml::node* mats = top.get("materials");
+  if (!mats) {
+    top.fail("materials",
+             "missing required table [materials] (one [materials.<name>] table per "
+             "material)");
+  }
+  const auto* mt = mats->as_table();
+  if (!mt)
+    top.fail("materials", "expected a table of materials ([materials.<name>]), " + got(*mats));
+  if (mt->empty()) top.fail("materials", "at least one material is required ([materials.<name>])");
+  const Origin mats_origin = top.origin_of(*mats);
+  // toml++ tables are sorted by key, so materials are numbered in alphabetical order; this
+  // keeps the numbering unchanged when Scene::toml is parsed again.
+  for (auto&& [name, node] : *mt) {
+    const std::string path = "materials." + std::string(name.str());
+    const Origin o = doc.origin(node, mats_origin);
+    const auto* t = node.as_table();
+    if (!t) {
+      throw InputError(doc.where(o, path), "expected a table ([" + path + "]), " + got(node));
+    }
+    Reader r(doc, *t, path, o,
+             {"density", "youngs_modulus", "poisson_ratio", "strength", "eos", "failure"});
+    s.materials.push_back(read_material(r, std::string(name.str())));
+  }
+}
+
+}  // namespace mpm::scene_toml
