@@ -3,6 +3,7 @@
 /// chosen by name from the scene. The solver calls Material::update once per block of
 /// particles of one material (never once per particle); the strength and EOS are called once
 /// per block too.
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -16,6 +17,12 @@ namespace mpm {
 
 /// Largest number of particles in one block.
 inline constexpr int kBlock = 64;
+
+/// The stable explicit step (s) for the fastest signal `speed` (m/s) on cells of size h (m):
+/// min(dt_max, cfl h / speed), dt_max when nothing moves (speed 0).
+inline double stable_time_step(double dt_max, double cfl, double h, double speed) {
+  return std::min(dt_max, speed > 0 ? cfl * h / speed : dt_max);
+}
 
 /// Why a particle's update failed (instability diagnosis).
 enum class PointFault : std::uint8_t { None, VolumeInverted, NonFinite };
@@ -114,6 +121,9 @@ class Material {
  private:
   void update_once(MaterialBlock& blk, BlockScratch& S) const;
   void update_plane_stress(MaterialBlock& blk, BlockScratch& S) const;
+  struct PlaneStressIteration;
+  void update_iterating(MaterialBlock& b, PlaneStressIteration& it, const int* idx, int k,
+                        BlockScratch& S) const;
 
   MaterialSpec spec_;
   double G_ = 0, K_ = 0;
