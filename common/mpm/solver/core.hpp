@@ -86,18 +86,6 @@ struct StressScratch {
   BlockScratch S;
 };
 
-/// The state columns a constitutive update changes: the particles' own or a trial copy
-/// (null where the scene has no such column).
-struct StateColumns {
-  Sym* sigma = nullptr;
-  double* rho = nullptr;
-  double* e = nullptr;
-  double* eps_p = nullptr;
-  double* T = nullptr;
-  std::uint8_t* failed = nullptr;
-  double* thickness = nullptr;
-};
-
 /// A run [i0, i0 + k) of particles of one material and one cell size waiting for their
 /// material update (which runs once per block, never once per particle).
 struct PendingBlock {
@@ -166,9 +154,10 @@ class SolverCore {
   /// particle that left the domain unless solver.on_exit = "remove" (then it is kept in
   /// exits_ for the next sort).
   void reduce(const std::vector<ChunkSums>& chunks, ChunkSums& total);
-  /// The material update of the pending block: masses m and state s (columns from particle
-  /// 0), velocity gradients in scr.L; returns the block (signal speeds in scr.c, faults).
-  MaterialBlock update_block(const PendingBlock& pb, const double* m, const StateColumns& s,
+  /// The material update of the pending block of the particles s (their own columns, or a
+  /// trial copy of the state), velocity gradients in scr.L; returns the block (signal speeds
+  /// in scr.c, faults).
+  MaterialBlock update_block(const PendingBlock& pb, const ParticleView<D>& s,
                              StressScratch& scr) const;
   /// Books the force F (N) the material exerts on rigid body `body` along `axis` in a step
   /// and the work the body does on the material.
@@ -204,23 +193,6 @@ class SolverCore {
   std::vector<std::unique_ptr<StressScratch>> scratch_;  ///< per thread
   mutable KernelTimers timers_;  ///< const kernels (residual, fold check) are timed too
 };
-
-/// The state columns of the particles themselves.
-template <int D>
-StateColumns state_columns(const ParticleView<D>& p) {
-  return {p.sigma, p.rho, p.e, p.eps_p, p.T, p.failed, p.thickness};
-}
-
-/// Copies particle i's state from the columns `from` to `to` (the optional ones `from` has).
-inline void copy_state(const StateColumns& from, const StateColumns& to, std::size_t i) {
-  to.sigma[i] = from.sigma[i];
-  to.rho[i] = from.rho[i];
-  to.e[i] = from.e[i];
-  if (from.eps_p) to.eps_p[i] = from.eps_p[i];
-  if (from.T) to.T[i] = from.T[i];
-  if (from.failed) to.failed[i] = from.failed[i];
-  if (from.thickness) to.thickness[i] = from.thickness[i];
-}
 
 /// "total energy grew by ..." for the energy guard.
 std::string energy_growth_message(double growth, double scale, double limit, const char* remedy);
@@ -327,24 +299,17 @@ void SolverCore<GridT>::reduce(const std::vector<ChunkSums>& chunks, ChunkSums& 
 }
 
 template <Grid GridT>
-MaterialBlock SolverCore<GridT>::update_block(const PendingBlock& pb, const double* m,
-                                              const StateColumns& s, StressScratch& scr) const {
-  const std::uint32_t i0 = pb.i0;
+MaterialBlock SolverCore<GridT>::update_block(const PendingBlock& pb, const ParticleView<D>& s,
+                                              StressScratch& scr) const {
   MaterialBlock blk;
   blk.n = pb.k;
   blk.dt = dt_;
   blk.h = pb.h;
   blk.L = scr.L;
-  blk.m = m + i0;
-  blk.sigma = s.sigma + i0;
-  blk.rho = s.rho + i0;
-  blk.e = s.e + i0;
-  blk.eps_p = s.eps_p ? s.eps_p + i0 : nullptr;
-  blk.T = s.T ? s.T + i0 : nullptr;
-  blk.failed = s.failed ? s.failed + i0 : nullptr;
+  blk.m = s.m + pb.i0;
+  blk.set_state(s.sigma, s.rho, s.e, s.eps_p, s.T, s.failed, s.thickness, pb.i0);
   blk.c = scr.c;
   blk.plane_stress = plane_stress_;
-  blk.thickness = s.thickness ? s.thickness + i0 : nullptr;
   materials_[pb.mat].update(blk, scr.S);
   return blk;
 }

@@ -55,16 +55,18 @@ class ExplicitSolver : public SolverCore<GridT> {
   /// What a particle kernel changed, for finish (bits).
   enum Changed { kVelocities = 1, kStresses = 2, kPositions = 4 };
 
-  // Kernels, in the order a step uses them (each in the file named after it).
+  // Kernels, in the order a step uses them, each in the file named after it: p2g.hpp,
+  // grid_update.hpp (grid_velocity, grid_update, grid_remap), g2p.hpp, stress.hpp and
+  // graded_split.hpp (split_particles).
   template <int F>
-  void p2g();                    // p2g.hpp
-  void grid_velocity();          // grid_update.hpp
-  void grid_update(NodeV in_v);  // grid_update.hpp
-  void grid_remap();             // grid_update.hpp
+  void p2g();
+  void grid_velocity();
+  void grid_update(NodeV in_v);
+  void grid_remap();
   template <G2pMode M>
-  void g2p();                                                                  // g2p.hpp
-  void update_stress(const std::vector<Vec<D>>& v_grad, Positions positions);  // stress.hpp
-  void split_particles() requires GridT::kGraded;                              // graded_split.hpp
+  void g2p();
+  void update_stress(const std::vector<Vec<D>>& v_grad, Positions positions);
+  void split_particles() requires GridT::kGraded;
 
   // Helpers.
   void mark_rigid_nodes();
@@ -86,6 +88,23 @@ class ExplicitSolver : public SolverCore<GridT> {
       }
     }
     grid_.locate(x, key, xi);
+  }
+  /// A particle of a bin, located: its cell and local coordinates there, and that cell's nodes.
+  struct InBin {
+    std::int64_t key;
+    Vec<D> xi;
+    bool home;               ///< still in the bin's cell
+    int nk;                  ///< nodes of its cell
+    const std::int64_t* nd;  ///< the bin's nodes at home, else `other` (filled)
+  };
+  [[gnu::always_inline]] InBin locate_in_bin(std::int64_t bin_key, const std::int64_t* nodes,
+                                             int nn, const Vec<D>& x, std::int64_t* other) const {
+    InBin at;
+    locate_in_bin(bin_key, x, at.key, at.xi);
+    at.home = at.key == bin_key;
+    at.nk = at.home ? nn : grid_.cell_nodes(at.key, other);
+    at.nd = at.home ? nodes : other;
+    return at;
   }
   void momentum_to_velocity(std::vector<Vec<D>>& field);
   void apply_boundary(std::vector<Vec<D>>& vel, std::vector<Vec<D>>* acc);

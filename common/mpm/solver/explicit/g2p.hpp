@@ -70,12 +70,7 @@ void ExplicitSolver<GridT>::g2p() {
         move_rigid(i, s, bin.key);
         continue;
       }
-      std::int64_t key;
-      Vec<D> xi;
-      locate_in_bin(bin.key, p.x[i], key, xi);
-      const bool home = key == bin.key;
-      const int nk = home ? nn : grid_.cell_nodes(key, other);
-      const std::int64_t* nd = home ? nodes : other;
+      const auto [key, xi, home, nk, nd] = locate_in_bin(bin.key, nodes, nn, p.x[i], other);
       double N[NMAX];
       advance_particle<M>(p, i, key, xi, nd, nk, home ? a_c : nullptr, home ? v_c : nullptr, N, s,
                           bin.key);

@@ -1,26 +1,28 @@
 // The scatter strategies' names.
 #include "mpm/solver/explicit/scatter.hpp"
 
+#include <utility>
+
 namespace mpm {
 
+namespace {
+constexpr std::pair<ScatterStrategy, const char*> kStrategyNames[] = {
+    {ScatterStrategy::Colored, "colored"},
+    {ScatterStrategy::LRSlabs, "lr-slabs"},
+    {ScatterStrategy::ArrayExpansion, "array-expansion"},
+    {ScatterStrategy::Patch, "patch"},
+};
+}  // namespace
+
 std::string to_string(ScatterStrategy s) {
-  switch (s) {
-    case ScatterStrategy::Colored:
-      return "colored";
-    case ScatterStrategy::LRSlabs:
-      return "lr-slabs";
-    case ScatterStrategy::ArrayExpansion:
-      return "array-expansion";
-    case ScatterStrategy::Patch:
-      return "patch";
-  }
+  for (const auto& [strategy, name] : kStrategyNames)
+    if (strategy == s) return name;
   return "?";
 }
 
 ScatterStrategy parse_strategy(const std::string& name, const std::string& where) {
-  for (auto s : {ScatterStrategy::Colored, ScatterStrategy::LRSlabs,
-                 ScatterStrategy::ArrayExpansion, ScatterStrategy::Patch})
-    if (to_string(s) == name) return s;
+  for (const auto& [strategy, strategy_name] : kStrategyNames)
+    if (name == strategy_name) return strategy;
   throw InputError(where, "unknown strategy '" + name +
                               "' (expected colored, lr-slabs, array-expansion or patch)");
 }

@@ -104,16 +104,12 @@ class Scatter {
     const Chunk& chunk = binning.chunks()[ch];
     for (std::uint32_t bi = chunk.bin_begin; bi < chunk.bin_end; ++bi) bin_body(ch, bi, t, strays);
   }
-  /// How the chunks of a colour are dealt to the threads.
-  enum class ChunkDeal { AsThreadsFree, ByThread };
 
   template <class BinBody, class ParticleBody>
   void colored(GridT& grid, const Binning& binning, BinBody& bin_body, ParticleBody& particle_body);
   template <class BinBody, class ParticleBody>
   void lr_slabs(GridT& grid, const Binning& binning, BinBody& bin_body,
                 ParticleBody& particle_body);
-  template <ChunkDeal kDeal, class BinBody>
-  void in_two_colours(const Target& t, const Binning& binning, BinBody& bin_body);
   template <class ParticleBody>
   void add_strays(GridT& grid, ParticleBody& particle_body);
   template <class BinBody>
@@ -156,45 +152,42 @@ void Scatter<GridT>::PrivateGrid::add_to(GridT& grid, int fields, std::int64_t n
   if (fields & kRemap) grid.v_remap[n] += q[k];
 }
 
-// Colored: chunks of a colour dealt to the threads as they come free (balanced by particle
-// count), then the strays.
+// Colored: two chunks of one colour never share a node, so a colour runs at a time, its
+// chunks dealt to the threads as they come free (balanced by particle count); then the strays.
 template <Grid GridT>
 template <class BinBody, class ParticleBody>
 void Scatter<GridT>::colored(GridT& grid, const Binning& binning, BinBody& bin_body,
                              ParticleBody& particle_body) {
-  in_two_colours<ChunkDeal::AsThreadsFree>(grid_target(grid), binning, bin_body);
-  add_strays(grid, particle_body);
-}
-
-// LR slabs (004, section 4.1): thread t runs the chunks 2t (L) and 2t + 1 (R), the L parts
-// then the R parts, then the strays.
-template <Grid GridT>
-template <class BinBody, class ParticleBody>
-void Scatter<GridT>::lr_slabs(GridT& grid, const Binning& binning, BinBody& bin_body,
-                              ParticleBody& particle_body) {
-  in_two_colours<ChunkDeal::ByThread>(grid_target(grid), binning, bin_body);
-  add_strays(grid, particle_body);
-}
-
-// Two chunks of one colour never share a node: run a colour at a time, the chunks of a colour
-// at once.
-template <Grid GridT>
-template <typename Scatter<GridT>::ChunkDeal kDeal, class BinBody>
-void Scatter<GridT>::in_two_colours(const Target& t, const Binning& binning, BinBody& bin_body) {
+  const Target t = grid_target(grid);
   const int nchunks = binning.chunk_count();
 #pragma omp parallel
   {
     std::vector<std::uint32_t>* strays = &strays_[omp_get_thread_num()];
     for (int color = 0; color < 2; ++color) {
-      if constexpr (kDeal == ChunkDeal::ByThread) {
-#pragma omp for schedule(static, 1)
-        for (int ch = color; ch < nchunks; ch += 2) run_chunk(binning, ch, bin_body, t, strays);
-      } else {
 #pragma omp for schedule(dynamic, 1)
-        for (int ch = color; ch < nchunks; ch += 2) run_chunk(binning, ch, bin_body, t, strays);
-      }
+      for (int ch = color; ch < nchunks; ch += 2) run_chunk(binning, ch, bin_body, t, strays);
     }
   }
+  add_strays(grid, particle_body);
+}
+
+// LR slabs (004, section 4.1): thread t runs the chunks 2t (its L part) and 2t + 1 (its R
+// part; 2t + 2T ... when there are more chunks than threads), every L part before every R
+// part; then the strays.
+template <Grid GridT>
+template <class BinBody, class ParticleBody>
+void Scatter<GridT>::lr_slabs(GridT& grid, const Binning& binning, BinBody& bin_body,
+                              ParticleBody& particle_body) {
+#pragma omp parallel
+  {
+    const int me = omp_get_thread_num(), threads = omp_get_num_threads();
+    for (int part = 0; part < 2; ++part) {
+      for (int ch = part + 2 * me; ch < binning.chunk_count(); ch += 2 * threads)
+        run_chunk(binning, ch, bin_body, grid_target(grid), &strays_[me]);
+#pragma omp barrier
+    }
+  }
+  add_strays(grid, particle_body);
 }
 
 // The particles that left their bin's slab layer, serially in particle order.

@@ -51,12 +51,7 @@ void ExplicitSolver<GridT>::stress_chunk(const ParticleView<D>& p, int ch, const
         }
         continue;
       }
-      std::int64_t key;
-      Vec<D> xi;
-      locate_in_bin(bin.key, p.x[i], key, xi);
-      const bool home = key == bin.key;
-      const int nk = home ? nn : grid_.cell_nodes(key, other);
-      const std::int64_t* nd = home ? nodes : other;
+      const auto [key, xi, home, nk, nd] = locate_in_bin(bin.key, nodes, nn, p.x[i], other);
       double N[NMAX];
       Vec<D> G[NMAX];
       grid_.shape(key, xi, N, G);
@@ -95,7 +90,7 @@ template <Grid GridT>
 void ExplicitSolver<GridT>::stress_block(const ParticleView<D>& p, PendingBlock& pb,
                                          StressScratch& scr, ChunkSums& s) const {
   if (pb.k == 0) return;
-  const MaterialBlock blk = update_block(pb, p.m, state_columns(p), scr);
+  const MaterialBlock blk = update_block(pb, p, scr);
   for (int j = 0; j < pb.k; ++j) {
     const std::uint32_t i = pb.i0 + j;
     s.internal += p.m[i] * p.e[i];

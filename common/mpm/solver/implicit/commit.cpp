@@ -130,7 +130,7 @@ void ImplicitSolver<GridT>::commit(const nk::Vector& u) {
   const auto& bins = binning_.bins();
   const auto& chunks = binning_.chunks();
   const double dt = dt_, floor = node_mass_floor_;
-  const StateColumns own = state_columns(p), trial = t.state(p);
+  const ParticleView<D> trial = t.view_of(p);
   std::vector<ChunkSums> sums(binning_.chunk_count());
   for_chunks([&](int ch) {
     ChunkSums& s = sums[ch];
@@ -150,7 +150,7 @@ void ImplicitSolver<GridT>::commit(const nk::Vector& u) {
           }
           p.v[i] = momentum ? t.v_p[i] : Vec<D>(p.v[i] + dv);
           p.x[i] += dt * vbar;
-          copy_state(trial, own, i);
+          copy_state(trial, i, p, i);
           s.internal += p.m[i] * p.e[i];
           s.add_motion(p, i, dt, gravity_);
         }

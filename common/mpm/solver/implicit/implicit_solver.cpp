@@ -1,6 +1,8 @@
 // Implicit MPM (001, sections 2.4 and 3.2). The time step is ImplicitSolver::step, right
 // below: particle to grid, the unknowns, a Newton-Krylov solve of the theta-scheme (cut and
-// retried while it fails), then the particles move. The residual's kernels follow it.
+// retried while it fails), then the particles move. Construction, particle to grid, the
+// unknowns and each attempt's set-up follow it; the residual's kernels are in residual.cpp,
+// the tangent preconditioner in tangent.cpp, the particle update in commit.cpp.
 #include "mpm/solver/implicit/implicit_solver.hpp"
 
 #include <omp.h>

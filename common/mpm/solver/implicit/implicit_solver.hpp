@@ -12,6 +12,7 @@
 /// the explicit solver (both are built on SolverCore, solver/core.hpp), and the same public
 /// interface, so the run driver treats both alike. With theta = 0 the momentum formulation is MUSL
 /// and the velocity formulation USL, step for step.
+#include <algorithm>
 #include <concepts>
 #include <cstdint>
 #include <memory>
@@ -143,6 +144,31 @@ class ImplicitSolver : public SolverCore<GridT> {
       for (int ch = colour; ch < n; ch += 2) body(ch);
     }
   }
+  /// Runs body(i, nd, nn, N, G) on each deformable particle of the bins [b0, b1): the nodes
+  /// nd[0, nn) of its cell and its shape functions N and their gradients G (1/m) at x_p^k.
+  template <class F>
+  void for_particles(std::uint32_t b0, std::uint32_t b1, F&& body) const {
+    const auto& bins = binning_.bins();
+    for (std::uint32_t bi = b0; bi < b1; ++bi) {
+      std::int64_t nd[NMAX];
+      const int nn = grid_.cell_nodes(bins[bi].key, nd);
+      for (std::uint32_t i = bins[bi].begin; i < bins[bi].end; ++i)
+        if (!rigid(i)) body(i, nd, nn, &N_p_[std::size_t(i) * NMAX], &G_p_[std::size_t(i) * NMAX]);
+    }
+  }
+  /// The same on the particles of chunk ch.
+  template <class F>
+  void for_particles_of_chunk(int ch, F&& body) const {
+    const Chunk& chunk = binning_.chunks()[ch];
+    for_particles(chunk.bin_begin, chunk.bin_end, body);
+  }
+  /// A scatter into a grid field: zeroes it, then runs body(i, nd, nn, N, G) (for_particles)
+  /// on every deformable particle, the chunks of a colour at once.
+  template <class F>
+  void scatter_particles(std::vector<Vec<D>>& field, F&& body) {
+    std::fill(field.begin(), field.end(), Vec<D>::Zero());
+    for_chunks_coloured([&](int ch) { for_particles_of_chunk(ch, body); });
+  }
   void move_velocity(const nk::Vector& u, std::vector<Vec<D>>& v_move) const;
   /// A node's velocity (or momentum) change as the particles get it: zero in the components a
   /// wall holds (the explicit solver's convention: a wall's acceleration is zero).
@@ -222,15 +248,17 @@ struct ImplicitSolver<GridT>::Trial {
     f_i.resize(nodes);
     P_i.resize(nodes);
   }
-  /// Its state columns, as the particles have them.
-  StateColumns state(const ParticleView<D>& p) {
-    return {sigma.data(),
-            rho.data(),
-            e.data(),
-            p.eps_p ? eps_p.data() : nullptr,
-            p.T ? T.data() : nullptr,
-            p.failed ? failed.data() : nullptr,
-            p.thickness ? thickness.data() : nullptr};
+  /// The particles p with this state in place of their own (the columns p has).
+  ParticleView<D> view_of(const ParticleView<D>& p) {
+    ParticleView<D> v = p;
+    v.sigma = sigma.data();
+    v.rho = rho.data();
+    v.e = e.data();
+    v.eps_p = p.eps_p ? eps_p.data() : nullptr;
+    v.T = p.T ? T.data() : nullptr;
+    v.failed = p.failed ? failed.data() : nullptr;
+    v.thickness = p.thickness ? thickness.data() : nullptr;
+    return v;
   }
 };
 

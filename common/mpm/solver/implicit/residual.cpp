@@ -29,18 +29,10 @@ template <LatticeGrid GridT>
 void ImplicitSolver<GridT>::remap_trial(const std::vector<Vec<D>>& P_L, Trial& t) {
   ScopedTimer timer(timers_, timers_.id("remap_trial"));
   const ParticleView<D> p = view<D>(particles_);
-  const auto& bins = binning_.bins();
-  const auto& chunks = binning_.chunks();
   const double floor = node_mass_floor_;
   std::vector<Vec<D>>& q = t.v_i;
-  std::fill(q.begin(), q.end(), Vec<D>::Zero());
-  for_chunks_coloured([&](int ch) {
-    for (std::uint32_t bi = chunks[ch].bin_begin; bi < chunks[ch].bin_end; ++bi) {
-      std::int64_t nd[NMAX];
-      const int nn = grid_.cell_nodes(bins[bi].key, nd);
-      for (std::uint32_t i = bins[bi].begin; i < bins[bi].end; ++i) {
-        if (rigid(i)) continue;
-        const double* N = &N_p_[i * NMAX];
+  scatter_particles(
+      q, [&](std::uint32_t i, const std::int64_t* nd, int nn, const double* N, const Vec<D>*) {
         Vec<D> v = p.v[i];
         for (int c = 0; c < nn; ++c)
           if (grid_.m[nd[c]] > floor)
@@ -48,9 +40,7 @@ void ImplicitSolver<GridT>::remap_trial(const std::vector<Vec<D>>& P_L, Trial& t
         t.v_p[i] = v;
         const Vec<D> mv = p.m[i] * v;
         for (int c = 0; c < nn; ++c) q[nd[c]] += N[c] * mv;
-      }
-    }
-  });
+      });
   const std::size_t nodes = grid_.nodes();
   for (std::size_t n = 0; n < nodes; ++n) {
     q[n] = grid_.m[n] > floor ? Vec<D>(q[n] / grid_.m[n]) : Vec<D>::Zero();
@@ -67,47 +57,40 @@ template <LatticeGrid GridT>
 bool ImplicitSolver<GridT>::stress_trial(Trial& t) {
   ScopedTimer timer(timers_, timers_.id("stress_trial"));
   const ParticleView<D> p = view<D>(particles_);
-  const auto& bins = binning_.bins();
-  const auto& chunks = binning_.chunks();
   const double dt = dt_;
   const bool axi = axisymmetric_;
+  const double h_cell = grid_.min_cell_size();  // a lattice grid's cells are all alike
   const std::vector<Vec<D>>& v_i = t.v_i;
   std::vector<char> bad(binning_.chunk_count(), 0);
 
-  const StateColumns own = state_columns(p), trial = t.state(p);
+  const ParticleView<D> trial = t.view_of(p);
   for_chunks([&](int ch) {
     StressScratch& scr = *scratch_[omp_get_thread_num()];
     PendingBlock pb;
     // Constitutive update of the pending block on a copy of its state at t^k.
     auto flush = [&]() {
       if (pb.k == 0) return;
-      for (std::uint32_t i = pb.i0; i < pb.i0 + std::uint32_t(pb.k); ++i) copy_state(own, trial, i);
-      if (update_block(pb, p.m, trial, scr).fault_index >= 0) bad[ch] = 1;
+      for (std::uint32_t i = pb.i0; i < pb.i0 + std::uint32_t(pb.k); ++i)
+        copy_state(p, i, trial, i);
+      if (update_block(pb, trial, scr).fault_index >= 0) bad[ch] = 1;
       pb.k = 0;
     };
-    for (std::uint32_t bi = chunks[ch].bin_begin; bi < chunks[ch].bin_end; ++bi) {
-      std::int64_t nd[NMAX];
-      const int nn = grid_.cell_nodes(bins[bi].key, nd);
-      const double h_cell = grid_.cell_size(bins[bi].key);
-      for (std::uint32_t i = bins[bi].begin; i < bins[bi].end; ++i) {
-        if (rigid(i)) continue;
-        const double* N = &N_p_[i * NMAX];
-        const Vec<D>* G = &G_p_[i * NMAX];
-        Mat3 L = Mat3::Zero();
-        double v_r = 0;
-        for (int c = 0; c < nn; ++c) {
-          L.template topLeftCorner<D, D>().noalias() += v_i[nd[c]] * G[c].transpose();
-          if (axi) v_r += N[c] * v_i[nd[c]][0];
-        }
-        if (axi) L(2, 2) = v_r / p.x[i][0];  // hoop rate
-        if (!((Mat3::Identity() + dt * L).determinant() > 0)) bad[ch] = 1;
-        if (pb.ends_before(i, p.material[i], h_cell)) {
-          flush();
-          pb.restart(i, p.material[i], h_cell);
-        }
-        scr.L[pb.k++] = L;
-      }
-    }
+    for_particles_of_chunk(
+        ch, [&](std::uint32_t i, const std::int64_t* nd, int nn, const double* N, const Vec<D>* G) {
+          Mat3 L = Mat3::Zero();
+          double v_r = 0;
+          for (int c = 0; c < nn; ++c) {
+            L.template topLeftCorner<D, D>().noalias() += v_i[nd[c]] * G[c].transpose();
+            if (axi) v_r += N[c] * v_i[nd[c]][0];
+          }
+          if (axi) L(2, 2) = v_r / p.x[i][0];  // hoop rate
+          if (!((Mat3::Identity() + dt * L).determinant() > 0)) bad[ch] = 1;
+          if (pb.ends_before(i, p.material[i], h_cell)) {
+            flush();
+            pb.restart(i, p.material[i], h_cell);
+          }
+          scr.L[pb.k++] = L;
+        });
     flush();
   });
   return std::none_of(bad.begin(), bad.end(), [](char b) { return b != 0; });
@@ -119,28 +102,16 @@ template <LatticeGrid GridT>
 void ImplicitSolver<GridT>::force_trial(Trial& t) {
   ScopedTimer timer(timers_, timers_.id("force_trial"));
   const ParticleView<D> p = view<D>(particles_);
-  const auto& bins = binning_.bins();
-  const auto& chunks = binning_.chunks();
   const bool axi = axisymmetric_;
-  std::vector<Vec<D>>& f = t.f_i;
-  std::fill(f.begin(), f.end(), Vec<D>::Zero());
-  for_chunks_coloured([&](int ch) {
-    for (std::uint32_t bi = chunks[ch].bin_begin; bi < chunks[ch].bin_end; ++bi) {
-      std::int64_t nd[NMAX];
-      const int nn = grid_.cell_nodes(bins[bi].key, nd);
-      for (std::uint32_t i = bins[bi].begin; i < bins[bi].end; ++i) {
-        if (rigid(i)) continue;
-        const double* N = &N_p_[i * NMAX];
-        const Vec<D>* G = &G_p_[i * NMAX];
-        const double V_p = p.m[i] / p.rho[i];
-        const Mat<D> Vsigma = V_p * to_matrix(t.sigma[i]).template topLeftCorner<D, D>();
-        const double Vs_hoop_r = axi ? V_p * t.sigma[i][2] / p.x[i][0] : 0.0;
-        for (int c = 0; c < nn; ++c) {
-          Vec<D> fc = -Vsigma * G[c];
-          if (axi) fc[0] -= Vs_hoop_r * N[c];
-          f[nd[c]] += fc;
-        }
-      }
+  scatter_particles(t.f_i, [&](std::uint32_t i, const std::int64_t* nd, int nn, const double* N,
+                               const Vec<D>* G) {
+    const double V_p = p.m[i] / p.rho[i];
+    const Mat<D> Vsigma = V_p * to_matrix(t.sigma[i]).template topLeftCorner<D, D>();
+    const double Vs_hoop_r = axi ? V_p * t.sigma[i][2] / p.x[i][0] : 0.0;
+    for (int c = 0; c < nn; ++c) {
+      Vec<D> fc = -Vsigma * G[c];
+      if (axi) fc[0] -= Vs_hoop_r * N[c];
+      t.f_i[nd[c]] += fc;
     }
   });
 }

@@ -2,11 +2,70 @@
 // assembled from the particles at the step's start, factored, and reused while it works.
 #include "mpm/solver/implicit/tangent.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "mpm/solver/implicit/implicit_solver.hpp"
 
 namespace mpm {
+
+namespace {
+
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+/// Strain (Voigt xx yy zz yz xz xy, shears doubled) per nodal velocity component.
+template <int D>
+using StrainMatrix = Eigen::Matrix<double, 6, D>;
+
+/// The tangent moduli of particle i in its state at t^k (Voigt, shears doubled): the elastic
+/// ones, less the plastic part on the yield surface, C_ep = C - 6 G^2 / (3 G + H) n n^T with
+/// n = s / |s| and H the hardening slope of the flow stress; a failed particle keeps only its
+/// bulk modulus.
+template <int D>
+Mat6 tangent_moduli(const Material& mat, const ParticleView<D>& p, std::uint32_t i) {
+  const bool failed = p.failed && p.failed[i];
+  const double G = failed ? 0.0 : mat.shear_modulus(), K = mat.spec().bulk_modulus();
+  const double lambda = K - 2.0 / 3.0 * G;
+  Mat6 C = Mat6::Zero();
+  C.template topLeftCorner<3, 3>().setConstant(lambda);
+  for (int a = 0; a < 3; ++a) C(a, a) += 2.0 * G, C(a + 3, a + 3) = G;
+  if (!failed && p.eps_p) {
+    const Sym s = deviator(p.sigma[i]);
+    const double s_norm = std::sqrt(ddot(s, s));
+    const double Tp = p.T ? p.T[i] : 0.0, ep = p.eps_p[i];
+    const double y = mat.strength().flow_stress(ep, 0.0, Tp);
+    if (std::isfinite(y) && s_norm > 0 && std::sqrt(1.5) * s_norm >= (1.0 - 1e-3) * y) {
+      const double de = 1e-6;
+      const double H =
+          std::clamp((mat.strength().flow_stress(ep + de, 0.0, Tp) - y) / de, 0.0, 1e3 * G);
+      const Sym n = s / s_norm;
+      C.noalias() -= 6.0 * G * G / (3.0 * G + H) * (n * n.transpose());
+    }
+  }
+  return C;
+}
+
+/// B of a node: the strain of its unit velocities from its shape function N and gradient Gr
+/// (1/m); in axisymmetry with the hoop row N / r (r: the particle's radius, m).
+template <int D>
+StrainMatrix<D> strain_matrix(double N, const Vec<D>& Gr, bool axisymmetric, double r) {
+  StrainMatrix<D> B = StrainMatrix<D>::Zero();
+  B(0, 0) = Gr[0];
+  B(1, 1) = Gr[1];
+  B(5, 0) = Gr[1];
+  B(5, 1) = Gr[0];
+  if constexpr (D == 3) {
+    B(2, 2) = Gr[2];
+    B(3, 1) = Gr[2];
+    B(3, 2) = Gr[1];
+    B(4, 0) = Gr[2];
+    B(4, 2) = Gr[0];
+  } else if (axisymmetric) {
+    B(2, 0) = N / r;
+  }
+  return B;
+}
+
+}  // namespace
 
 /// The tangent preconditioner for a step dt: the last factor while it was built for the same
 /// unknowns and dt and still works (the last solve took at most 1.5 times the Krylov
@@ -56,82 +115,41 @@ bool ImplicitSolver<GridT>::factor_tangent(double dt) {
     dof_of[std::size_t(dof_node_[d]) * D + std::size_t(dof_axis_[d])] = std::int64_t(d);
     if (!momentum) entries.emplace_back(int(d), int(d), grid_.m[dof_node_[d]]);
   }
-  using Mat6 = Eigen::Matrix<double, 6, 6>;
-  using B6 = Eigen::Matrix<double, 6, D>;  // strain (Voigt xx yy zz yz xz xy, shears doubled)
   const double c = spec_.theta * dt * dt;
   const ParticleView<D> p = view<D>(particles_);
   const bool axi = axisymmetric_;
-  for (const Bin& bin : binning_.bins()) {
-    std::int64_t nd_c[NMAX];
-    const int nn = grid_.cell_nodes(bin.key, nd_c);
-    for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
-      if (rigid(i)) continue;
-      const Material& mat = materials_[p.material[i]];
-      const bool failed = p.failed && p.failed[i];
-      const double G = failed ? 0.0 : mat.shear_modulus(), K = mat.spec().bulk_modulus();
-      const double lambda = K - 2.0 / 3.0 * G;
-      Mat6 C = Mat6::Zero();
-      C.template topLeftCorner<3, 3>().setConstant(lambda);
-      for (int a = 0; a < 3; ++a) C(a, a) += 2.0 * G, C(a + 3, a + 3) = G;
-      if (!failed && p.eps_p) {
-        const Sym s = deviator(p.sigma[i]);
-        const double s_norm = std::sqrt(ddot(s, s));
-        const double Tp = p.T ? p.T[i] : 0.0, ep = p.eps_p[i];
-        const double y = mat.strength().flow_stress(ep, 0.0, Tp);
-        if (std::isfinite(y) && s_norm > 0 && std::sqrt(1.5) * s_norm >= (1.0 - 1e-3) * y) {
-          const double de = 1e-6;
-          const double H =
-              std::clamp((mat.strength().flow_stress(ep + de, 0.0, Tp) - y) / de, 0.0, 1e3 * G);
-          const Sym n = s / s_norm;
-          C.noalias() -= 6.0 * G * G / (3.0 * G + H) * (n * n.transpose());
-        }
-      }
-      const double V = p.m[i] / p.rho[i];
-      const double* N = &N_p_[std::size_t(i) * NMAX];
-      const Vec<D>* Gr = &G_p_[std::size_t(i) * NMAX];
-      B6 B[NMAX];
-      for (int a = 0; a < nn; ++a) {
-        B[a].setZero();
-        B[a](0, 0) = Gr[a][0];
-        B[a](1, 1) = Gr[a][1];
-        B[a](5, 0) = Gr[a][1];
-        B[a](5, 1) = Gr[a][0];
-        if constexpr (D == 3) {
-          B[a](2, 2) = Gr[a][2];
-          B[a](3, 1) = Gr[a][2];
-          B[a](3, 2) = Gr[a][1];
-          B[a](4, 0) = Gr[a][2];
-          B[a](4, 2) = Gr[a][0];
-        } else if (axi) {
-          B[a](2, 0) = N[a] / p.x[i][0];
-        }
-      }
-      if (momentum)
-        for (int a = 0; a < nn; ++a)
-          for (int b = 0; b < nn; ++b)
+  for_particles(
+      0, std::uint32_t(binning_.bins().size()),
+      [&](std::uint32_t i, const std::int64_t* nd_c, int nn, const double* N, const Vec<D>* Gr) {
+        const Mat6 C = tangent_moduli(materials_[p.material[i]], p, i);
+        const double V = p.m[i] / p.rho[i];
+        StrainMatrix<D> B[NMAX];
+        for (int a = 0; a < nn; ++a) B[a] = strain_matrix<D>(N[a], Gr[a], axi, p.x[i][0]);
+        if (momentum)
+          for (int a = 0; a < nn; ++a)
+            for (int b = 0; b < nn; ++b)
+              for (int r = 0; r < D; ++r) {
+                const std::int64_t row = dof_of[std::size_t(nd_c[a]) * D + std::size_t(r)];
+                const std::int64_t col = dof_of[std::size_t(nd_c[b]) * D + std::size_t(r)];
+                if (row >= 0 && col >= 0 && N[a] * N[b] != 0)
+                  remap.emplace_back(int(row), int(col),
+                                     p.m[i] * N[a] * N[b] / (grid_.m[nd_c[a]] * grid_.m[nd_c[b]]));
+              }
+        for (int b = 0; b < nn; ++b) {
+          const StrainMatrix<D> CB = C * B[b];
+          for (int a = 0; a < nn; ++a) {
+            const Mat<D> Kab = (c * V) * (B[a].transpose() * CB);
             for (int r = 0; r < D; ++r) {
               const std::int64_t row = dof_of[std::size_t(nd_c[a]) * D + std::size_t(r)];
-              const std::int64_t col = dof_of[std::size_t(nd_c[b]) * D + std::size_t(r)];
-              if (row >= 0 && col >= 0 && N[a] * N[b] != 0)
-                remap.emplace_back(int(row), int(col),
-                                   p.m[i] * N[a] * N[b] / (grid_.m[nd_c[a]] * grid_.m[nd_c[b]]));
-            }
-      for (int b = 0; b < nn; ++b) {
-        const Eigen::Matrix<double, 6, D> CB = C * B[b];
-        for (int a = 0; a < nn; ++a) {
-          const Mat<D> Kab = (c * V) * (B[a].transpose() * CB);
-          for (int r = 0; r < D; ++r) {
-            const std::int64_t row = dof_of[std::size_t(nd_c[a]) * D + std::size_t(r)];
-            if (row < 0) continue;
-            for (int q = 0; q < D; ++q) {
-              const std::int64_t col = dof_of[std::size_t(nd_c[b]) * D + std::size_t(q)];
-              if (col >= 0 && Kab(r, q) != 0) entries.emplace_back(int(row), int(col), Kab(r, q));
+              if (row < 0) continue;
+              for (int q = 0; q < D; ++q) {
+                const std::int64_t col = dof_of[std::size_t(nd_c[b]) * D + std::size_t(q)];
+                if (col >= 0 && Kab(r, q) != 0) entries.emplace_back(int(row), int(col), Kab(r, q));
+              }
             }
           }
         }
-      }
-    }
-  }
+      });
   const auto n_unknowns = static_cast<Eigen::Index>(nd);
   Eigen::SparseMatrix<double> A(n_unknowns, n_unknowns);
   A.setFromTriplets(entries.begin(), entries.end());

@@ -189,6 +189,7 @@ struct Material::PlaneStressIteration {
   Sym sigma0[kBlock];
   double rho0[kBlock], e0[kBlock], ep0[kBlock], T0[kBlock];
   std::uint8_t f0[kBlock];
+  MaterialBlock start;  ///< the state of t^n: those columns (the ones the block has)
   Mat3 L[kBlock];
   ThicknessRoot root[kBlock];
   PointFault fault_of[kBlock];
@@ -199,13 +200,10 @@ void Material::update_plane_stress(MaterialBlock& b, BlockScratch& S) const {
   PlaneStressIteration it;
   const double lambda = K_ - 2.0 * G_ / 3.0, M = K_ + 4.0 / 3.0 * G_;
   const double k0 = M * b.dt;  // elastic d sigma_zz / d L_zz
+  it.start.set_state(it.sigma0, it.rho0, it.e0, b.eps_p ? it.ep0 : nullptr, b.T ? it.T0 : nullptr,
+                     b.failed ? it.f0 : nullptr, nullptr, 0);
   for (int i = 0; i < n; ++i) {
-    it.sigma0[i] = b.sigma[i];
-    it.rho0[i] = b.rho[i];
-    it.e0[i] = b.e[i];
-    if (b.eps_p) it.ep0[i] = b.eps_p[i];
-    if (b.T) it.T0[i] = b.T[i];
-    if (b.failed) it.f0[i] = b.failed[i];
+    copy_state(b, i, it.start, i);
     it.L[i] = b.L[i];
     // Elastic estimate from the old sigma_zz and the in-plane rate.
     it.root[i].d = -(lambda * (it.L[i](0, 0) + it.L[i](1, 1)) + it.sigma0[i][2] / b.dt) / M;
@@ -248,14 +246,9 @@ void Material::update_iterating(MaterialBlock& b, PlaneStressIteration& it, cons
   g.n = k;
   g.L = g_L;
   g.m = g_m;
-  g.sigma = g_sigma;
-  g.rho = g_rho;
-  g.e = g_e;
-  g.eps_p = b.eps_p ? g_ep : nullptr;
-  g.T = b.T ? g_T : nullptr;
-  g.failed = b.failed ? g_f : nullptr;
+  g.set_state(g_sigma, g_rho, g_e, b.eps_p ? g_ep : nullptr, b.T ? g_T : nullptr,
+              b.failed ? g_f : nullptr, nullptr, 0);
   g.c = g_c;
-  g.thickness = nullptr;
   g.fault_index = -1;
   g.fault = PointFault::None;
   for (int j = 0; j < k; ++j) {
@@ -263,24 +256,14 @@ void Material::update_iterating(MaterialBlock& b, PlaneStressIteration& it, cons
     it.L[i](2, 2) = it.root[i].d;
     g_L[j] = it.L[i];
     g_m[j] = b.m[i];
-    g_sigma[j] = it.sigma0[i];
-    g_rho[j] = it.rho0[i];
-    g_e[j] = it.e0[i];
-    if (b.eps_p) g_ep[j] = it.ep0[i];
-    if (b.T) g_T[j] = it.T0[i];
-    if (b.failed) g_f[j] = it.f0[i];
+    copy_state(it.start, i, g, j);
     it.fault_of[i] = PointFault::None;
   }
   update_once(g, S);
   if (g.fault_index >= 0) it.fault_of[idx[g.fault_index]] = g.fault;
   for (int j = 0; j < k; ++j) {
     const int i = idx[j];
-    b.sigma[i] = g_sigma[j];
-    b.rho[i] = g_rho[j];
-    b.e[i] = g_e[j];
-    if (b.eps_p) b.eps_p[i] = g_ep[j];
-    if (b.T) b.T[i] = g_T[j];
-    if (b.failed) b.failed[i] = g_f[j];
+    copy_state(g, j, b, i);
     b.c[i] = g_c[j];
   }
 }

@@ -49,7 +49,33 @@ struct MaterialBlock {
       nullptr;           ///< plane stress: thickness / initial thickness (in/out; may be null)
   int fault_index = -1;  ///< out: first particle whose update failed, -1 if none
   PointFault fault = PointFault::None;
+
+  /// Points the state at columns from their element i0 (the optional ones null when absent).
+  void set_state(Sym* sigma_, double* rho_, double* e_, double* eps_p_, double* T_,
+                 std::uint8_t* failed_, double* thickness_, std::size_t i0) {
+    sigma = sigma_ + i0;
+    rho = rho_ + i0;
+    e = e_ + i0;
+    eps_p = eps_p_ ? eps_p_ + i0 : nullptr;
+    T = T_ ? T_ + i0 : nullptr;
+    failed = failed_ ? failed_ + i0 : nullptr;
+    thickness = thickness_ ? thickness_ + i0 : nullptr;
+  }
 };
+
+/// Copies the state (sigma, rho, e and, where both have them, eps_p, T, failed and
+/// thickness) of element i of `from` to element j of `to`: particle columns (ParticleView) or
+/// a block (MaterialBlock).
+template <class From, class To>
+void copy_state(const From& from, std::size_t i, const To& to, std::size_t j) {
+  to.sigma[j] = from.sigma[i];
+  to.rho[j] = from.rho[i];
+  to.e[j] = from.e[i];
+  if (from.eps_p && to.eps_p) to.eps_p[j] = from.eps_p[i];
+  if (from.T && to.T) to.T[j] = from.T[i];
+  if (from.failed && to.failed) to.failed[j] = from.failed[i];
+  if (from.thickness && to.thickness) to.thickness[j] = from.thickness[i];
+}
 
 /// Scratch shared by the stages of one block update (owned by the caller, one per thread).
 struct BlockScratch {
