@@ -107,10 +107,11 @@ void ExplicitSolver<GridT>::g2p() {
 /// copies, or null to read the grid); returns its shape function values in N for the remap.
 template <Grid GridT>
 template <typename ExplicitSolver<GridT>::G2pMode M>
-[[gnu::always_inline]] inline void ExplicitSolver<GridT>::advance_particle(
-    const ParticleView<D>& p, std::uint32_t i, std::int64_t key, const Vec<D>& xi,
-    const std::int64_t* nd, int nk, const Vec<D>* a_c, const Vec<D>* v_c, double* N, ChunkSums& s,
-    std::int64_t bin_key) const {
+void ExplicitSolver<GridT>::advance_particle(const ParticleView<D>& p, std::uint32_t i,
+                                             std::int64_t key, const Vec<D>& xi,
+                                             const std::int64_t* nd, int nk, const Vec<D>* a_c,
+                                             const Vec<D>* v_c, double* N, ChunkSums& s,
+                                             std::int64_t bin_key) const {
   constexpr bool kMove = M == G2pMode::Move;
   const double dt = dt_;
   grid_.values(key, xi, N);

@@ -92,7 +92,13 @@ class Scatter {
     void clear(int fields);
     Target target() { return Target{m.data(), v.data(), a.data(), q.data(), offset}; }
     /// Adds its fields at node n into the grid.
-    void add_to(GridT& grid, int fields, std::int64_t n) const;
+    [[gnu::always_inline]] void add_to(GridT& grid, int fields, std::int64_t n) const {
+      const std::int64_t k = n - offset;
+      if (fields & kMass) grid.m[n] += m[k];
+      if (fields & kMomentum) grid.v[n] += v[k];
+      if (fields & kForce) grid.a[n] += a[k];
+      if (fields & kRemap) grid.v_remap[n] += q[k];
+    }
   };
   static Target grid_target(GridT& grid) {
     return Target{grid.m.data(), grid.v.data(), grid.a.data(), grid.v_remap.data(), 0};
@@ -141,15 +147,6 @@ void Scatter<GridT>::PrivateGrid::clear(int fields) {
   if (fields & kMomentum) v.assign(n, Vec<D>::Zero());
   if (fields & kForce) a.assign(n, Vec<D>::Zero());
   if (fields & kRemap) q.assign(n, Vec<D>::Zero());
-}
-
-template <Grid GridT>
-void Scatter<GridT>::PrivateGrid::add_to(GridT& grid, int fields, std::int64_t n) const {
-  const std::int64_t k = n - offset;
-  if (fields & kMass) grid.m[n] += m[k];
-  if (fields & kMomentum) grid.v[n] += v[k];
-  if (fields & kForce) grid.a[n] += a[k];
-  if (fields & kRemap) grid.v_remap[n] += q[k];
 }
 
 // Colored: two chunks of one colour never share a node, so a colour runs at a time, its

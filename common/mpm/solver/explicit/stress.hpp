@@ -22,10 +22,12 @@ void ExplicitSolver<GridT>::update_stress(const std::vector<Vec<D>>& v_grad, Pos
   finish(stats, positions == Positions::Move ? kStresses | kPositions : kStresses);
 }
 
-/// The stress update of the particles of chunk ch from the grid velocities vg_i.
+/// The stress update of the particles of chunk ch from the grid velocities vg_i (flattened:
+/// every call but the material update's is inlined into its loop).
 template <Grid GridT>
-void ExplicitSolver<GridT>::stress_chunk(const ParticleView<D>& p, int ch, const Vec<D>* vg_i,
-                                         Positions positions, ChunkSums& s) {
+[[gnu::flatten]] void ExplicitSolver<GridT>::stress_chunk(const ParticleView<D>& p, int ch,
+                                                          const Vec<D>* vg_i, Positions positions,
+                                                          ChunkSums& s) {
   StressScratch& scr = *scratch_[omp_get_thread_num()];
   const Vec<D>* v_i = grid_.v.data();
   const auto& bins = binning_.bins();
