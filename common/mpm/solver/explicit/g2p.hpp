@@ -30,8 +30,10 @@ void ExplicitSolver<GridT>::g2p() {
       track_move(p.x[i], i, bin_key, s);
     }
   };
-  // One particle on its own: update (when first visited) and remap into a target.
-  auto particle_body = [&](std::uint32_t i, const Target& t, bool first_visit, int unit) {
+  // One particle on its own: update (when first visited) and remap into a target. The bodies
+  // are flattened (every call inlined), as the kernel's hot loops.
+  auto particle_body = [&] [[gnu::flatten]] (std::uint32_t i, const Target& t, bool first_visit,
+                                             int unit) {
     std::int64_t key, nd[NMAX];
     Vec<D> xi;
     grid_.locate(p.x[i], key, xi);
@@ -52,8 +54,8 @@ void ExplicitSolver<GridT>::g2p() {
     }
   };
   // One bin with its cell's nodal values cached.
-  auto bin_body = [&](int ch, std::uint32_t bi, const Target& t,
-                      std::vector<std::uint32_t>* strays) {
+  auto bin_body = [&] [[gnu::flatten]] (int ch, std::uint32_t bi, const Target& t,
+                                        std::vector<std::uint32_t>* strays) {
     ChunkSums& s = stats[ch];
     const Bin& bin = bins[bi];
     const int layer = grid_.layer(bin.key);
