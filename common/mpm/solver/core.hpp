@@ -106,6 +106,8 @@ struct PendingBlock {
   }
 };
 
+/// The state and bookkeeping both solvers share; ExplicitSolver and ImplicitSolver derive
+/// from it and add their step and kernels. Its accessors are the solvers' common interface.
 template <Grid GridT>
 class SolverCore {
  public:
