@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <concepts>
 #include <cstdint>
 #include <vector>
 
@@ -192,20 +193,42 @@ class CellLattice {
   IVec<D> cells_;  ///< domain cells per axis
 };
 
-// What the kernels need of a grid (UniformGrid here; a graded grid provides the same):
-//   static constexpr int kMaxNodes;     nodes of a cell, at most
-//   static constexpr bool kFixedNodes;  every cell has kMaxNodes nodes
-//   static constexpr bool kGraded;      levels: the step splits particles (graded_grid.hpp)
-//   void fit(const Vec<D>* x, size_t n);              window/levels for these particles
-//   Where where(x, key, xi);                          cell key and local coordinates of x
-//   void locate(x, key, xi);                          the same for x known to be in the window
-//   int cell_nodes(key, nodes[]);                     node indices of a cell, returns the count
-//   void shape(key, xi, N[], G[]); values(key, xi, N[]);   shape functions, gradients in 1/m
-//   std::size_t key_count();                          keys are in [0, key_count())
-//   int layer(key); int layers();                     slab layers for the coloured scatter
-//   double cell_size(key); double min_cell_size();    m
-//   std::size_t nodes(); m, v, a, v_remap, rigid;     node data
-//   fixed_nodes(), slip_nodes();                      nodes on constrained domain faces
+/// What the solvers' kernels need of a grid: UniformGrid, SparseGrid and GradedGrid.
+template <class G>
+concept Grid = requires(G& g, const G& cg, const Vec<G::kDim>* xs, std::size_t n,
+                        const Vec<G::kDim>& x, std::int64_t& key, Vec<G::kDim>& xi,
+                        std::int64_t* nodes, double* N, Vec<G::kDim>* dN) {
+  // 2D or 3D; nodes of a cell at most; every cell has kMaxNodes; levels (particles split).
+  requires G::kDim == 2 || G::kDim == 3;
+  { G::kMaxNodes } -> std::convertible_to<int>;
+  { G::kFixedNodes } -> std::convertible_to<bool>;
+  { G::kGraded } -> std::convertible_to<bool>;
+  // The window (and levels) for n particles at xs.
+  g.fit(xs, n);
+  // Cell key and local coordinates of x (locate: x known to be in the window); a cell's
+  // nodes (returns their count), shape functions and gradients (1/m); keys in
+  // [0, key_count()), in slab layers for the coloured scatter; cell sizes, m.
+  { cg.where(x, key, xi) } -> std::same_as<Where>;
+  cg.locate(x, key, xi);
+  { cg.cell_nodes(key, nodes) } -> std::same_as<int>;
+  cg.shape(key, xi, N, dN);
+  cg.values(key, xi, N);
+  { cg.key_count() } -> std::same_as<std::size_t>;
+  { cg.layer(key) } -> std::same_as<int>;
+  { cg.layers() } -> std::same_as<int>;
+  { cg.cell_size(key) } -> std::same_as<double>;
+  { cg.min_cell_size() } -> std::same_as<double>;
+  // Node data (GridNodes), cleared for a step, and the nodes on constrained domain faces.
+  { cg.nodes() } -> std::same_as<std::size_t>;
+  { g.m } -> std::same_as<std::vector<double>&>;
+  { g.v } -> std::same_as<std::vector<Vec<G::kDim>>&>;
+  { g.a } -> std::same_as<std::vector<Vec<G::kDim>>&>;
+  { g.v_remap } -> std::same_as<std::vector<Vec<G::kDim>>&>;
+  { g.rigid } -> std::same_as<std::vector<std::uint8_t>&>;
+  g.clear(true, true);
+  { cg.fixed_nodes().front().node } -> std::convertible_to<std::int64_t>;
+  { cg.slip_nodes().front().face } -> std::convertible_to<int>;
+};
 
 template <int D>
 class UniformGrid : public CellLattice<D>, public GridNodes<D> {
@@ -284,5 +307,7 @@ class UniformGrid : public CellLattice<D>, public GridNodes<D> {
   std::array<std::int64_t, kCorners<D>> corner_{};
   int slab_ = D - 1;
 };
+
+static_assert(Grid<UniformGrid<2>> && Grid<UniformGrid<3>>);
 
 }  // namespace mpm

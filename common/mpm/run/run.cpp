@@ -173,9 +173,72 @@ std::string run_info(const Scene& scene, const Lattice& lat, int threads) {
   return o.str();
 }
 
+/// The next step (s): the solver's stable step, landing exactly on the next frame time and
+/// avoiding a sliver step just before it.
+template <class Solver>
+double next_step(Solver& solver, double next_frame) {
+  double dt = solver.stable_dt();
+  const double to_frame = next_frame - solver.time();
+  if (dt >= to_frame)
+    dt = to_frame;
+  else if (dt > 0.5 * to_frame)
+    dt = 0.5 * to_frame;
+  if (!(dt > 0) || !std::isfinite(dt))
+    throw InstabilityError(solver.steps(), solver.time(), -1,
+                           "the stable time step is " + std::to_string(dt) + " s");
+  return dt;
+}
+
+/// The --stats report on stderr: kernel times, throughput, memory and the solver's work; the
+/// time loop took loop_wall seconds.
+template <class Solver>
+void print_stats(Solver& solver, int threads, double loop_wall) {
+  constexpr bool implicit = HasImplicitWork<Solver>;
+  using GridT = std::remove_cvref_t<decltype(solver.grid())>;
+  const double ps = solver.particle_steps();
+  const double wall = solver.timers().total();
+  std::fprintf(stderr, "\n%s", solver.timers().table(ps).c_str());
+  std::string strategy = "colored";
+  std::size_t work_bytes = 0;
+  if constexpr (!implicit) {
+    strategy = to_string(solver.strategy());
+    work_bytes = solver.work_bytes();
+  }
+  std::fprintf(stderr,
+               "\nstrategy %s, threads %d, particles %zu, steps %ld, sorts %ld, particle-steps "
+               "%.4g, %.3f million particle-steps/s\n",
+               strategy.c_str(), threads, solver.particles().size(), solver.steps(),
+               solver.binning().sorts(), ps, wall > 0 ? ps / wall / 1e6 : 0.0);
+  if constexpr (GridT::kGraded)
+    std::fprintf(stderr, "graded grid: %d levels, %zu cells, %zu nodes; %ld particles split\n",
+                 solver.grid().levels(), solver.grid().key_count(), solver.grid().nodes(),
+                 solver.splits());
+  const double peak = peak_memory();
+  std::fprintf(
+      stderr,
+      "peak memory %.1f MB, %.0f bytes per particle (all of the process: particles, "
+      "grid window, sort scratch, the model as read); particle columns %zu bytes, grid "
+      "window %zu nodes%s\n",
+      peak / 1e6, peak / double(std::max<std::size_t>(1, solver.particles().size())),
+      solver.particles().element_bytes(), solver.grid().nodes(),
+      implicit ? ""
+               : (", solver work arrays " + std::to_string(work_bytes / 1000000) + " MB").c_str());
+  if constexpr (implicit) {
+    const ImplicitWork& w = solver.work();
+    std::fprintf(stderr,
+                 "implicit: explicit dt %.6g s, steps %ld, newton %ld, krylov %ld, residual "
+                 "evaluations %ld, line-search cuts %ld, step cuts %ld (lagrangian %ld), wall "
+                 "%.4f s (time loop)\n",
+                 solver.explicit_dt(), w.steps, w.newton, w.krylov, w.evaluations,
+                 w.line_search_cuts, w.step_cuts, w.lagrangian_cuts, loop_wall);
+  } else {
+    std::fprintf(stderr, "explicit: steps %ld, wall %.4f s (time loop)\n", solver.steps(),
+                 loop_wall);
+  }
+}
+
 template <class Solver>
 int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Solver& solver) {
-  constexpr int D = Solver::D;
   constexpr bool implicit = HasImplicitWork<Solver>;
   using GridT = std::remove_cvref_t<decltype(solver.grid())>;
   const int threads = omp_get_max_threads();
@@ -199,7 +262,7 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
   KernelTimers& timers = solver.timers();
   const int t_output = timers.id("output");
 
-  History history(D, scene, implicit);
+  History history(Solver::D, scene, implicit);
   auto emit_frame = [&](std::uint32_t flags) {
     ScopedTimer timer(timers, t_output);
     history.flush(out);
@@ -244,16 +307,7 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
         message = "stopped at solver.max_steps = " + std::to_string(max_steps);
         break;
       }
-      // Land exactly on frame times; avoid a sliver step just before one.
-      double dt = solver.stable_dt();
-      const double to_frame = next_frame - solver.time();
-      if (dt >= to_frame)
-        dt = to_frame;
-      else if (dt > 0.5 * to_frame)
-        dt = 0.5 * to_frame;
-      if (!(dt > 0) || !std::isfinite(dt))
-        throw InstabilityError(solver.steps(), solver.time(), -1,
-                               "the stable time step is " + std::to_string(dt) + " s");
+      double dt = next_step(solver, next_frame);
       solver.step(dt);
       if constexpr (implicit) dt = solver.last_dt();  // cut when Newton failed
       if (solver.time() >= next_history * (1 - 1e-12) || o.history_interval <= 0) {
@@ -297,49 +351,7 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
   if (solver.removed_particles() > 0)
     std::fprintf(stderr, "mpm-run: %zu particles left the domain and were removed\n",
                  solver.removed_particles());
-  if (opt.stats) {
-    const double ps = solver.particle_steps();
-    const double wall = timers.total();
-    std::fprintf(stderr, "\n%s", timers.table(ps).c_str());
-    std::string strategy = "colored";
-    std::size_t work_bytes = 0;
-    if constexpr (!implicit) {
-      strategy = to_string(solver.strategy());
-      work_bytes = solver.work_bytes();
-    }
-    std::fprintf(stderr,
-                 "\nstrategy %s, threads %d, particles %zu, steps %ld, sorts %ld, particle-steps "
-                 "%.4g, %.3f million particle-steps/s\n",
-                 strategy.c_str(), threads, solver.particles().size(), solver.steps(),
-                 solver.binning().sorts(), ps, wall > 0 ? ps / wall / 1e6 : 0.0);
-    if constexpr (GridT::kGraded)
-      std::fprintf(stderr, "graded grid: %d levels, %zu cells, %zu nodes; %ld particles split\n",
-                   solver.grid().levels(), solver.grid().key_count(), solver.grid().nodes(),
-                   solver.splits());
-    const double peak = peak_memory();
-    std::fprintf(
-        stderr,
-        "peak memory %.1f MB, %.0f bytes per particle (all of the process: particles, "
-        "grid window, sort scratch, the model as read); particle columns %zu bytes, grid "
-        "window %zu nodes%s\n",
-        peak / 1e6, peak / double(std::max<std::size_t>(1, solver.particles().size())),
-        solver.particles().element_bytes(), solver.grid().nodes(),
-        implicit
-            ? ""
-            : (", solver work arrays " + std::to_string(work_bytes / 1000000) + " MB").c_str());
-    if constexpr (implicit) {
-      const ImplicitWork& w = solver.work();
-      std::fprintf(stderr,
-                   "implicit: explicit dt %.6g s, steps %ld, newton %ld, krylov %ld, residual "
-                   "evaluations %ld, line-search cuts %ld, step cuts %ld (lagrangian %ld), wall "
-                   "%.4f s (time loop)\n",
-                   solver.explicit_dt(), w.steps, w.newton, w.krylov, w.evaluations,
-                   w.line_search_cuts, w.step_cuts, w.lagrangian_cuts, loop_wall);
-    } else {
-      std::fprintf(stderr, "explicit: steps %ld, wall %.4f s (time loop)\n", solver.steps(),
-                   loop_wall);
-    }
-  }
+  if (opt.stats) print_stats(solver, threads, loop_wall);
   return status;
 }
 

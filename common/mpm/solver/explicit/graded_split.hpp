@@ -2,7 +2,7 @@
 // Particle splitting on graded grids (004, section 3.3): a particle whose spacing is that of a
 // coarser level than the cell it has moved into splits into 2^D children of the finer level,
 // so that no fine cell between two coarse particles stays empty ("numerical fracture",
-// 004 Fig. 8). Included by graded_solver.cpp after explicit_solver_impl.hpp.
+// 004 Fig. 8).
 //
 // Parallel, with no serial pass over the particles and no lock (004, section 4.3 ran this step
 // serially because it appends to the particle list):
@@ -22,25 +22,67 @@
 // reproducible.
 #include <cmath>
 #include <cstring>
+#include <limits>
 
-#include "mpm/grid/graded_grid.hpp"
 #include "mpm/solver/explicit/explicit_solver.hpp"
 
 namespace mpm {
 
-template <class GridT>
-void ExplicitSolver<GridT>::split_particles() {
+/// The particles to split, found by the scan in fixed blocks of particles.
+template <Grid GridT>
+struct ExplicitSolver<GridT>::SplitScan {
+  static constexpr int kKids = 1 << D;            ///< children of a split
+  static constexpr std::size_t kSpan = 8192;      ///< particles per scan block
+  std::vector<std::vector<std::uint32_t>> found;  ///< by block, in particle order
+  std::vector<std::size_t> first;                 ///< by block: its first split's index; count
+  std::size_t count() const { return first.back(); }
+};
+
+template <Grid GridT>
+void ExplicitSolver<GridT>::split_particles() requires GridT::kGraded {
   ScopedTimer timer(timers_, timers_.id("split_particles"));
-  constexpr int kKids = 1 << D;
-  constexpr std::size_t kSpan = 8192;  // particles per scan block
-  ParticleView<D> p = view<D>(particles_);
+  constexpr int kKids = SplitScan::kKids;
+  const std::size_t n = particles_.size();
+  const SplitScan scan = scan_for_splits();
+  const std::size_t k = scan.count();
+  if (k == 0) return;
+  constexpr int kSplitWait = 10;  // steps
+  if (!need_sort_ && split_wait_ < kSplitWait && k * 200 < n) {
+    ++split_wait_;
+    return;
+  }
+  split_wait_ = 0;
+  if (n + k * (kKids - 1) > std::numeric_limits<std::uint32_t>::max())
+    throw InstabilityError(steps_ + 1, time_ + dt_, -1,
+                           "particle splitting would exceed 2^32 particles; use fewer levels");
+  if (next_id_ == 0) {
+    const ParticleView<D> p = view<D>(particles_);
+    std::uint32_t top = 0;
+#pragma omp parallel for reduction(max : top) schedule(static)
+    for (std::size_t i = 0; i < n; ++i) top = std::max(top, p.id[i]);
+    next_id_ = top + 1;
+  }
+  if (std::uint64_t(next_id_) + k * (kKids - 1) > std::numeric_limits<std::uint32_t>::max())
+    throw InstabilityError(steps_ + 1, time_ + dt_, -1, "particle ids exceed 2^32 after splitting");
+  write_children(scan, n);
+  next_id_ += std::uint32_t(k * (kKids - 1));
+  split_count_ += long(k);
+  need_sort_ = true;  // children were appended: back to cell order before the next kernel
+}
+
+/// 1. Scan: particles coarser than the level box they are in; the followed body's moments
+/// (a move of the boxes asks for a sort: the grid rebuilds then). 2. Slots: split j (in
+/// particle order) writes children 1.. to n + (kKids - 1) j + ....
+template <Grid GridT>
+auto ExplicitSolver<GridT>::scan_for_splits() -> SplitScan requires GridT::kGraded {
+  constexpr std::size_t kSpan = SplitScan::kSpan;
+  const ParticleView<D> p = view<D>(particles_);
   std::uint8_t* level = particles_.template get<std::uint8_t>(col::level);
   const std::size_t n = p.n;
   const std::size_t nblocks = (n + kSpan - 1) / kSpan;
   const int follow = grid_.followed_body();
-
-  // 1. Scan: particles coarser than the level box they are in; the followed body's moments.
-  std::vector<std::vector<std::uint32_t>> found(nblocks);
+  SplitScan scan;
+  scan.found.resize(nblocks);
   std::vector<double> mass(nblocks, 0.0);
   std::vector<Vec<D>> moment(nblocks, Vec<D>::Zero());
 #pragma omp parallel for schedule(dynamic, 4)
@@ -51,7 +93,7 @@ void ExplicitSolver<GridT>::split_particles() {
         level[i] = std::uint8_t(std::max(1, grid_.level_at(p.x[i])));
         continue;
       }
-      if (grid_.in_finer(p.x[i], level[i])) found[b].push_back(std::uint32_t(i));
+      if (grid_.in_finer(p.x[i], level[i])) scan.found[b].push_back(std::uint32_t(i));
       if (follow >= 0 && p.body[i] == follow) {
         mass[b] += p.m[i];
         moment[b] += p.m[i] * p.x[i];
@@ -64,34 +106,22 @@ void ExplicitSolver<GridT>::split_particles() {
     for (std::size_t b = 0; b < nblocks; ++b) M += mass[b], S += moment[b];
     if (M > 0 && grid_.follow(S / M)) need_sort_ = true;  // the grid rebuilds at the sort
   }
+  scan.first.assign(nblocks + 1, 0);
+  for (std::size_t b = 0; b < nblocks; ++b)
+    scan.first[b + 1] = scan.first[b] + scan.found[b].size();
+  return scan;
+}
 
-  // 2. Slots: split j (in particle order) writes children 1.. to n + (kKids - 1) j + ....
-  std::vector<std::size_t> first(nblocks + 1, 0);
-  for (std::size_t b = 0; b < nblocks; ++b) first[b + 1] = first[b] + found[b].size();
-  const std::size_t k = first[nblocks];
-  if (k == 0) return;
-  constexpr int kSplitWait = 10;  // steps
-  if (!need_sort_ && split_wait_ < kSplitWait && k * 200 < n) {
-    ++split_wait_;
-    return;
-  }
-  split_wait_ = 0;
-  const std::size_t total = n + k * (kKids - 1);
-  if (total > std::numeric_limits<std::uint32_t>::max())
-    throw InstabilityError(steps_ + 1, time_ + dt_, -1,
-                           "particle splitting would exceed 2^32 particles; use fewer levels");
-  if (next_id_ == 0) {
-    std::uint32_t top = 0;
-#pragma omp parallel for reduction(max : top) schedule(static)
-    for (std::size_t i = 0; i < n; ++i) top = std::max(top, p.id[i]);
-    next_id_ = top + 1;
-  }
-  if (std::uint64_t(next_id_) + k * (kKids - 1) > std::numeric_limits<std::uint32_t>::max())
-    throw InstabilityError(steps_ + 1, time_ + dt_, -1, "particle ids exceed 2^32 after splitting");
-  particles_.resize(total);
-  p = view<D>(particles_);
+/// 3. Children, each split to its own slots: the columns grow from n particles, child 0
+/// replaces its parent.
+template <Grid GridT>
+void ExplicitSolver<GridT>::write_children(const SplitScan& scan,
+                                           std::size_t n) requires GridT::kGraded {
+  constexpr int kKids = SplitScan::kKids;
+  particles_.resize(n + scan.count() * (kKids - 1));
+  const ParticleView<D> p = view<D>(particles_);
   material_ = p.material;
-  level = particles_.template get<std::uint8_t>(col::level);
+  std::uint8_t* level = particles_.template get<std::uint8_t>(col::level);
   struct Bytes {
     std::byte* data;
     std::size_t size;
@@ -104,13 +134,12 @@ void ExplicitSolver<GridT>::split_particles() {
   const Vec<D> lo = grid_.domain_min(), hi = grid_.domain_max();
   const double inset = 1e-9 * grid_.min_cell_size();
   const std::uint32_t id0 = next_id_;
-
-  // 3. Children, each split to its own slots.
+  const long nblocks = long(scan.found.size());
 #pragma omp parallel for schedule(dynamic, 4)
-  for (long b = 0; b < long(nblocks); ++b) {
-    for (std::size_t q = 0; q < found[b].size(); ++q) {
-      const std::size_t j = first[b] + q;
-      const std::uint32_t i = found[b][q];
+  for (long b = 0; b < nblocks; ++b) {
+    for (std::size_t q = 0; q < scan.found[b].size(); ++q) {
+      const std::size_t j = scan.first[b] + q;
+      const std::uint32_t i = scan.found[b][q];
       const std::size_t slot = n + j * (kKids - 1);  // child c >= 1 at slot + c - 1
       // Children 1..: copies of the parent: velocity, stress, strain, specific energy,
       // plastic strain, temperature and every history variable (004, section 3.3).
@@ -141,9 +170,6 @@ void ExplicitSolver<GridT>::split_particles() {
       }
     }
   }
-  next_id_ += std::uint32_t(k * (kKids - 1));
-  split_count_ += long(k);
-  need_sort_ = true;  // children were appended: back to cell order before the next kernel
 }
 
 }  // namespace mpm

@@ -5,6 +5,7 @@
 
 namespace mpm {
 
+static_assert(Grid<SparseGrid<2>> && Grid<SparseGrid<3>>);
 template class ExplicitSolver<SparseGrid<2>>;
 template class ExplicitSolver<SparseGrid<3>>;
 

@@ -1,6 +1,6 @@
 #pragma once
-/// The explicit solver on the sparse grid (nodes only around the occupied cells): the kernels
-/// of explicit_solver_impl.hpp unchanged. Instantiated in sparse_solver.cpp.
+/// The explicit solver on the sparse grid (nodes only around the occupied cells): the explicit
+/// kernels unchanged. Instantiated in sparse_solver.cpp.
 #include "mpm/grid/sparse_grid.hpp"
 #include "mpm/solver/explicit/explicit_solver.hpp"
 

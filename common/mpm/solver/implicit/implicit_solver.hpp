@@ -4,26 +4,26 @@
 /// solved for the grid velocities (velocity formulation, symmetric: Newton-CG) or the grid
 /// momenta (momentum formulation, eqs. 3.2.1-3.2.7, non-symmetric: Newton-GMRES) of the free
 /// nodes, matrix-free (Jacobian products by the directional difference of eq. 2.4.18). The
-/// time step is ImplicitSolver::step, at the top of implicit_solver.cpp.
+/// time step is ImplicitSolver::step, at the top of implicit_solver.cpp; the residual's kernels
+/// are in residual.cpp, the tangent preconditioner in tangent.cpp, the particle update after
+/// convergence in commit.cpp.
 ///
 /// Same particles, grid window, binning, materials, boundary conditions and rigid bodies as
-/// the explicit solver (explicit_solver.hpp), and the same public interface, so the run driver
-/// treats both alike. With theta = 0 the momentum formulation is MUSL and the velocity
-/// formulation USL, step for step.
-#include <array>
+/// the explicit solver (both are built on SolverCore, solver/core.hpp), and the same public
+/// interface, so the run driver treats both alike. With theta = 0 the momentum formulation is MUSL
+/// and the velocity formulation USL, step for step.
+#include <algorithm>
+#include <concepts>
+#include <cstdint>
 #include <memory>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
-#include "mpm/core/columns.hpp"
-#include "mpm/core/timers.hpp"
-#include "mpm/grid/binning.hpp"
 #include "mpm/grid/grid.hpp"
-#include "mpm/scene/particles.hpp"
 #include "mpm/scene/scene.hpp"
-#include "mpm/solver/explicit/explicit_solver.hpp"  // Balance, InstabilityError
+#include "mpm/solver/core.hpp"
 #include "mpm/solver/implicit/newton_krylov.hpp"
-#include "mpm/solver/materials/material.hpp"
 
 namespace mpm {
 
@@ -39,8 +39,24 @@ struct ImplicitWork {
   ImplicitWork& operator+=(const ImplicitWork& o);
 };
 
-template <class GridT>
-class ImplicitSolver {
+/// A grid whose nodes have indices in the lattice of the whole domain (the warm start and
+/// the tangent's unknowns survive refits of the window by them): the uniform window.
+template <class G>
+concept LatticeGrid = Grid<G> && requires(const G& g, std::int64_t node) {
+  { g.global_node(node) } -> std::same_as<IVec<G::kDim>>;
+};
+
+struct TangentFactor;
+
+/// Below this many particles the kernels run on one thread: a residual evaluation of a small
+/// 2D scene takes microseconds, less than waking the OpenMP team (much less on a loaded
+/// machine), and a Newton-Krylov step makes dozens of them.
+inline constexpr std::size_t kParallelParticles = 4096;
+
+template <LatticeGrid GridT>
+class ImplicitSolver : public SolverCore<GridT> {
+  using Core = SolverCore<GridT>;
+
  public:
   static constexpr int D = GridT::kDim;
 
@@ -62,28 +78,13 @@ class ImplicitSolver {
   /// The explicit (CFL) step the multiples refer to, s: cfl h / max_p(c_p + |v_p|) of the
   /// initial state (as ExplicitSolver's first step).
   double explicit_dt() const { return dt_explicit_; }
-  double time() const { return time_; }
-  long steps() const { return steps_; }
   /// The last step taken, s.
   double last_dt() const { return last_dt_; }
-  double particle_steps() const { return particle_steps_; }
-  /// Energies and momentum after the last step (leapfrog_total = total: no half steps here).
-  const Balance& balance() const { return balance_; }
-  /// Force (N) on each constrained face in the last step, as ExplicitSolver::face_force.
-  const std::array<double, 6>& face_force() const { return face_force_; }
-  /// Force (N) the material exerts on each rigid body in the last step, by body.
-  const std::vector<Vec3>& rigid_force() const { return rigid_force_; }
   /// Work totals since the start, and of the last step (retries included).
   const ImplicitWork& work() const { return work_; }
   const ImplicitWork& last_work() const { return last_work_; }
   /// ||F||_2 of the dimensionless residual at each Newton iterate of the last attempt.
   const std::vector<double>& last_residuals() const { return last_residuals_; }
-  ColumnStore& particles() { return particles_; }
-  const GridT& grid() const { return grid_; }
-  const Binning& binning() const { return binning_; }
-  KernelTimers& timers() { return timers_; }
-  std::size_t removed_particles() const { return removed_count_; }
-  const Scene& scene() const { return scene_; }
 
   // For tests and studies: the nonlinear system of one step, without taking it. ----------
   /// Sets up a step of size dt from the current state (sort, particle to grid, unknowns) and
@@ -104,34 +105,71 @@ class ImplicitSolver {
   static constexpr int NMAX = GridT::kMaxNodes;
   class System;
   struct Trial;
-  struct Scratch;
-  struct Tangent;
 
   // Kernels, in the order a step uses them.
-  void sort_particles();
   void p2g();               // m_i, P_i^k, f_i^k, f_i^ext, stiffness diagonal, rigid marks
   void free_dofs();         // Dirichlet values and the unknowns
   bool attempt(double dt);  // Newton-Krylov for one dt; true when converged and unfolded
   nk::NonlinearSystem& system_for_current(double dt, nk::Vector& u0);  // scale, guess, diagonal
-  bool tangent_for(double dt);     // preconditioner = "tangent": the last factor, or a new one
-  bool factor_tangent(double dt);  // M + theta dt^2 K_t (or its momentum form), factored
-  void to_grid(const nk::Vector& u, std::vector<Vec<D>>& w) const;  // unknowns to grid
+  bool tangent_for(double dt);     // tangent.cpp: the last factor, or a new one
+  bool factor_tangent(double dt);  // tangent.cpp: M + theta dt^2 K_t (or its momentum form)
+  void to_grid(const nk::Vector& u, std::vector<Vec<D>>& w) const;  // residual.cpp ...
   void remap_trial(const std::vector<Vec<D>>& P_L, Trial& t);       // momentum: v_p^L, v_i^L
   bool stress_trial(Trial& t);  // velocity gradient, constitutive update on a copy
   void force_trial(Trial& t);   // f_i^L from the trial stress
   void residual(const nk::Vector& u, const Trial& t, nk::Vector& F) const;
-  bool folds(const std::vector<Vec<D>>& v) const;  // Lagrangian step restriction
+  bool folds(const std::vector<Vec<D>>& v) const;  // commit.cpp: Lagrangian step restriction
   bool crosses_axis(const nk::Vector& u) const;    // axisymmetry: a particle would reach r < 0
   void reactions(const nk::Vector& u);             // forces on rigid bodies and faces
   void commit(const nk::Vector& u);                // particles: v, x, stress state; energies
 
   // Helpers.
+  /// Runs body(chunk) on every chunk, in parallel from kParallelParticles particles.
   template <class F>
-  void for_chunks(F&& body);
+  void for_chunks(F&& body) {
+    const int n = binning_.chunk_count();
+    const bool parallel = particles_.size() >= kParallelParticles;
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
+    for (int ch = 0; ch < n; ++ch) body(ch);
+  }
+  /// The same for a scatter: chunks of one colour never touch the same node (binning.hpp), so
+  /// they run at once, colour by colour, with no lock; each node's sum has a fixed order
+  /// whatever the threads.
   template <class F>
-  void for_chunks_coloured(F&& body);
+  void for_chunks_coloured(F&& body) {
+    const int n = binning_.chunk_count();
+    const bool parallel = particles_.size() >= kParallelParticles;
+    for (int colour = 0; colour < 2; ++colour) {
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
+      for (int ch = colour; ch < n; ch += 2) body(ch);
+    }
+  }
+  /// Runs body(i, nd, nn, N, G) on each deformable particle of the bins [b0, b1): the nodes
+  /// nd[0, nn) of its cell and its shape functions N and their gradients G (1/m) at x_p^k.
+  template <class F>
+  void for_particles(std::uint32_t b0, std::uint32_t b1, F&& body) const {
+    const auto& bins = binning_.bins();
+    for (std::uint32_t bi = b0; bi < b1; ++bi) {
+      std::int64_t nd[NMAX];
+      const int nn = grid_.cell_nodes(bins[bi].key, nd);
+      for (std::uint32_t i = bins[bi].begin; i < bins[bi].end; ++i)
+        if (!rigid(i)) body(i, nd, nn, &N_p_[std::size_t(i) * NMAX], &G_p_[std::size_t(i) * NMAX]);
+    }
+  }
+  /// The same on the particles of chunk ch.
+  template <class F>
+  void for_particles_of_chunk(int ch, F&& body) const {
+    const Chunk& chunk = binning_.chunks()[ch];
+    for_particles(chunk.bin_begin, chunk.bin_end, body);
+  }
+  /// A scatter into a grid field: zeroes it, then runs body(i, nd, nn, N, G) (for_particles)
+  /// on every deformable particle, the chunks of a colour at once.
+  template <class F>
+  void scatter_particles(std::vector<Vec<D>>& field, F&& body) {
+    std::fill(field.begin(), field.end(), Vec<D>::Zero());
+    for_chunks_coloured([&](int ch) { for_particles_of_chunk(ch, body); });
+  }
   void move_velocity(const nk::Vector& u, std::vector<Vec<D>>& v_move) const;
-  bool rigid(std::uint32_t i) const { return material_[i] == kRigidMaterial; }
   /// A node's velocity (or momentum) change as the particles get it: zero in the components a
   /// wall holds (the explicit solver's convention: a wall's acceleration is zero).
   Vec<D> increment(std::int64_t n, Vec<D> d) const {
@@ -139,31 +177,22 @@ class ImplicitSolver {
       if (face_held_[n] >> a & 1) d[a] = 0;
     return d;
   }
+  /// A node's index in the lattice (the whole domain), which survives refits of the window.
+  std::int64_t global_key(std::int64_t node) const;
+  void remember(const nk::Vector& u);
 
-  Scene scene_;
+  using Core::axisymmetric_, Core::balance_, Core::binning_, Core::dt_, Core::exits_,
+      Core::face_force_, Core::gravity_, Core::grid_, Core::has_rigid_, Core::materials_,
+      Core::need_sort_, Core::node_mass_floor_, Core::particles_, Core::rigid_force_,
+      Core::rigid_held_, Core::rigid_velocity_, Core::scene_, Core::scratch_, Core::steps_,
+      Core::time_, Core::timers_;
+  using Core::book_rigid_force, Core::reduce, Core::rigid, Core::sort_particles, Core::track_move,
+      Core::update_block;
+
   ImplicitSpec spec_;
-  ColumnStore& particles_;
-  GridT grid_;
-  Binning binning_;
-  std::vector<Material> materials_;
-  bool axisymmetric_ = false, plane_stress_ = false, has_rigid_ = false;
-  std::vector<Vec<D>> rigid_velocity_;
-  std::vector<std::uint8_t> rigid_held_;  ///< by body: the components it imposes (bits)
-  std::vector<Vec3> rigid_force_;
-  Vec<D> gravity_ = Vec<D>::Zero();
-  double dt_explicit_ = 0, next_dt_ = 0, dt_ = 0, last_dt_ = 0, time_ = 0;
-  long steps_ = 0;
-  double particle_steps_ = 0;
-  bool need_sort_ = true;
+  double dt_explicit_ = 0, next_dt_ = 0, last_dt_ = 0;  ///< s
   double cell_measure_ = 0;  ///< dx dy (plane strain), dx dy r_ref (axisymmetric), dx dy dz
   double youngs_max_ = 0;    ///< Y of the residual scale: the largest Young's modulus
-  double node_mass_floor_ = 0;
-  const std::uint8_t* material_ = nullptr;
-  std::vector<std::uint32_t> exits_;
-  std::size_t removed_count_ = 0;
-  Balance balance_;
-  double total0_ = 0, energy_scale_ = 0;
-  std::array<double, 6> face_force_{};
 
   // The step being solved (grid-sized unless noted).
   std::vector<Vec<D>> P_k_;              ///< P_i^k = sum_p m_p v_p N_ip (001, eq. 3.2.3)
@@ -182,20 +211,55 @@ class ImplicitSolver {
   /// The last accepted step's grid velocities v_i^L and masses, by global node (for
   /// initial_guess = "previous"; node indices change when the window is refitted).
   std::unordered_map<std::int64_t, std::pair<double, Vec<D>>> previous_;
-  std::int64_t global_key(std::int64_t node) const;
-  void remember(const nk::Vector& u);
   nk::Vector inv_diag_;
-  std::unique_ptr<Tangent> tangent_;  ///< the factored M + theta dt^2 K_t (preconditioner)
-  nk::Preconditioner precond_;        ///< of the step being solved; empty: none
-  bool tangent_in_use_ = false;       ///< precond_ is the tangent's factor
-  nk::Vector u_;                      ///< the converged unknowns
+  std::unique_ptr<TangentFactor> tangent_;  ///< the factored M + theta dt^2 K_t (tangent.hpp)
+  nk::Preconditioner precond_;              ///< of the step being solved; empty: none
+  bool tangent_in_use_ = false;             ///< precond_ is the tangent's factor
+  nk::Vector u_;                            ///< the converged unknowns
   std::unique_ptr<Trial> trial_, accepted_;
   std::unique_ptr<System> system_;
-  std::vector<std::unique_ptr<Scratch>> scratch_;  ///< per thread
 
   ImplicitWork work_, last_work_;
   std::vector<double> last_residuals_;
-  mutable KernelTimers timers_;  ///< const kernels (residual, fold check) are timed too
+};
+
+/// Trial state of one residual evaluation: the constitutive state at t^L from a trial grid
+/// velocity (computed on a copy: Material::update works in place), and the grid fields.
+template <LatticeGrid GridT>
+struct ImplicitSolver<GridT>::Trial {
+  std::vector<Sym> sigma;
+  std::vector<double> rho, e, eps_p, T, thickness;
+  std::vector<std::uint8_t> failed;
+  std::vector<Vec<D>> v_p;  ///< momentum formulation: particle velocities v_p^L (eq. 3.2.6)
+  std::vector<Vec<D>> v_i;  ///< grid velocity the strain increment came from (eq. 3.2.7)
+  std::vector<Vec<D>> f_i;  ///< internal force from the trial stress (eq. 2.4.7)
+  std::vector<Vec<D>> P_i;  ///< momentum formulation: trial grid momenta
+  /// Sizes the state to n particles (the columns p has) and the grid fields to `nodes`.
+  void resize(std::size_t n, std::size_t nodes, const ParticleView<D>& p) {
+    sigma.resize(n);
+    rho.resize(n);
+    e.resize(n);
+    eps_p.resize(p.eps_p ? n : 0);
+    T.resize(p.T ? n : 0);
+    thickness.resize(p.thickness ? n : 0);
+    failed.resize(p.failed ? n : 0);
+    v_p.resize(n);
+    v_i.resize(nodes);
+    f_i.resize(nodes);
+    P_i.resize(nodes);
+  }
+  /// The particles p with this state in place of their own (the columns p has).
+  ParticleView<D> view_of(const ParticleView<D>& p) {
+    ParticleView<D> v = p;
+    v.sigma = sigma.data();
+    v.rho = rho.data();
+    v.e = e.data();
+    v.eps_p = p.eps_p ? eps_p.data() : nullptr;
+    v.T = p.T ? T.data() : nullptr;
+    v.failed = p.failed ? failed.data() : nullptr;
+    v.thickness = p.thickness ? thickness.data() : nullptr;
+    return v;
+  }
 };
 
 }  // namespace mpm

@@ -27,6 +27,18 @@ std::string to_string(Outcome o) {
 // ------------------------------------------------------------------------------------------
 // Conjugate gradients (001, Algorithm 3), preconditioned.
 
+namespace {
+/// A Krylov solve's start: x = 0 (n unknowns), which solves it when ||b|| = 0 (then true,
+/// the report converged).
+bool starts_solved(double b_norm, Vector& x, Eigen::Index n, LinearReport& rep) {
+  x.setZero(n);
+  if (b_norm != 0) return false;
+  rep.converged = true;
+  rep.relative_residual = 0;
+  return true;
+}
+}  // namespace
+
 Preconditioner diagonal_preconditioner(const Vector& inv_diag) {
   return [&inv_diag](const Vector& r, Vector& z) { z = inv_diag.cwiseProduct(r); };
 }
@@ -35,13 +47,8 @@ LinearReport cg(const Operator& A, const Vector& b, Vector& x, double rtol, int 
                 const Preconditioner* P) {
   LinearReport rep;
   const Eigen::Index n = b.size();
-  x.setZero(n);
   const double b_norm = b.norm();
-  if (b_norm == 0) {
-    rep.converged = true;
-    rep.relative_residual = 0;
-    return rep;
-  }
+  if (starts_solved(b_norm, x, n, rep)) return rep;
   Vector r = b;  // r_0 = b - A 0
   Vector z = r;
   if (P) (*P)(r, z);
@@ -87,13 +94,8 @@ LinearReport gmres(const Operator& A, const Vector& b, Vector& x, double rtol, i
                    int restarts, const Preconditioner* P) {
   LinearReport rep;
   const Eigen::Index n = b.size();
-  x.setZero(n);
   const double b_norm = b.norm();
-  if (b_norm == 0) {
-    rep.converged = true;
-    rep.relative_residual = 0;
-    return rep;
-  }
+  if (starts_solved(b_norm, x, n, rep)) return rep;
   const int m = std::max(1, basis);
   Eigen::MatrixXd V(n, m + 1);  // orthonormal basis p_1 .. p_{k+1}
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m + 1, m);

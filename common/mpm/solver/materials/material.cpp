@@ -124,143 +124,148 @@ void Material::update(MaterialBlock& b, BlockScratch& S) const {
 // viscosity switching on in compression, failure). Every evaluation runs the whole update from
 // the saved state of t^n, so the strength model, the EOS, the bulk viscosity and failure need
 // no plane-stress variant of their own.
-void Material::update_plane_stress(MaterialBlock& b, BlockScratch& S) const {
-  const int n = b.n;
+
+namespace {
+/// One particle's search for the root of sigma_zz(d) = 0.
+struct ThicknessRoot {
+  double d = 0, d_prev = 0, r_prev = 0;  ///< rate d = L_zz (1/s); the last one, its sigma_zz
+  double lo = -std::numeric_limits<double>::infinity(), r_lo = 0;  ///< bracket: r_lo < 0 < r_hi
+  double hi = std::numeric_limits<double>::infinity(), r_hi = 0;
+  int side = 0;  ///< which end the last evaluation replaced: -1 lo, +1 hi, 0 none yet
+  bool done = false;
+
+  /// The next rate from sigma_zz = r at d after update pass `pass` (>= 1): false when the
+  /// particle has converged (then done), L being its velocity gradient, M = K + 4G/3 and
+  /// k0 = M dt the elastic slope; `s` its stress.
+  bool advance(const Sym& s, const Mat3& L, double M, double k0, double dt, int pass) {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    const double r = s[2];
+    const double rate_scale =
+        std::abs(L(0, 0)) + std::abs(L(1, 1)) + std::abs(L(0, 1)) + std::abs(d);
+    // Converged: sigma_zz below 1e-12 of the stress, or within a few units of round-off of
+    // a stress from the density (M x 1e-16: a particle at rest under noise-level stresses has
+    // nothing finer to converge to), or not finite (the update reports that).
+    const double scale =
+        std::max({std::abs(s[0]), std::abs(s[1]), std::abs(s[5])}) + k0 * rate_scale;
+    if (!(std::abs(r) > 1e-12 * scale + 1e-15 * M) || !std::isfinite(r)) {
+      done = true;
+      return false;
+    }
+    if (r > 0) {
+      if (side == 1) r_lo *= 0.5;  // Illinois: the other end was kept twice
+      hi = d, r_hi = r, side = 1;
+    } else {
+      if (side == -1) r_hi *= 0.5;
+      lo = d, r_lo = r, side = -1;
+    }
+    double next;
+    if (lo > -inf && hi < inf) {
+      next = (lo * r_hi - hi * r_lo) / (r_hi - r_lo);
+      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      // No root left to find: a jump of sigma_zz(d) (the EOS's thermal term switching off
+      // at rho0), or a bracket narrower than a representable change of the density.
+      if (hi - lo <= 1e-9 * rate_scale || (hi - lo) * dt <= 1e-15) done = true;
+    } else {
+      next = d - r / k0;
+      if (pass > 1 && r != r_prev && d != d_prev) {
+        const double slope = (r - r_prev) / (d - d_prev);
+        if (slope > 0) next = d - r / slope;
+      }
+    }
+    d_prev = d;
+    r_prev = r;
+    if (std::abs(next - d) <= 1e-13 * rate_scale || std::abs(next - d) * dt <= 1e-16)
+      done = true;  // a step at round-off
+    if (done) return false;
+    d = next;
+    return true;
+  }
+};
+}  // namespace
+
+/// A block's plane-stress iteration: the state of t^n, the velocity gradients and each
+/// particle's root search and fault.
+struct Material::PlaneStressIteration {
   Sym sigma0[kBlock];
   double rho0[kBlock], e0[kBlock], ep0[kBlock], T0[kBlock];
   std::uint8_t f0[kBlock];
+  MaterialBlock start;  ///< the state of t^n: those columns (the ones the block has)
   Mat3 L[kBlock];
-  double d[kBlock], d_prev[kBlock], r_prev[kBlock];
-  double lo[kBlock], hi[kBlock], r_lo[kBlock], r_hi[kBlock];  // bracket: r_lo < 0 < r_hi
-  int side[kBlock];  // which end the last evaluation replaced: -1 lo, +1 hi, 0 none yet
-  bool done[kBlock];
-  constexpr double inf = std::numeric_limits<double>::infinity();
+  ThicknessRoot root[kBlock];
+  PointFault fault_of[kBlock];
+};
+
+void Material::update_plane_stress(MaterialBlock& b, BlockScratch& S) const {
+  const int n = b.n;
+  PlaneStressIteration it;
   const double lambda = K_ - 2.0 * G_ / 3.0, M = K_ + 4.0 / 3.0 * G_;
   const double k0 = M * b.dt;  // elastic d sigma_zz / d L_zz
+  it.start.set_state(it.sigma0, it.rho0, it.e0, b.eps_p ? it.ep0 : nullptr, b.T ? it.T0 : nullptr,
+                     b.failed ? it.f0 : nullptr, nullptr, 0);
   for (int i = 0; i < n; ++i) {
-    sigma0[i] = b.sigma[i];
-    rho0[i] = b.rho[i];
-    e0[i] = b.e[i];
-    if (b.eps_p) ep0[i] = b.eps_p[i];
-    if (b.T) T0[i] = b.T[i];
-    if (b.failed) f0[i] = b.failed[i];
-    L[i] = b.L[i];
+    copy_state(b, i, it.start, i);
+    it.L[i] = b.L[i];
     // Elastic estimate from the old sigma_zz and the in-plane rate.
-    d[i] = -(lambda * (L[i](0, 0) + L[i](1, 1)) + sigma0[i][2] / b.dt) / M;
-    L[i](2, 2) = d[i];
-    lo[i] = -inf, hi[i] = inf;
-    side[i] = 0;
-    done[i] = false;
+    it.root[i].d = -(lambda * (it.L[i](0, 0) + it.L[i](1, 1)) + it.sigma0[i][2] / b.dt) / M;
+    it.L[i](2, 2) = it.root[i].d;
   }
   // Pass 0 updates the whole block in place; later passes only the particles not yet
   // converged, gathered into a sub-block (a kink or a jump of sigma_zz(d) in one particle, where
   // the root needs many passes, must not make the other 63 repeat their update).
   const Mat3* L_in = b.L;
-  b.L = L;
+  b.L = it.L;
   update_once(b, S);
-  PointFault fault_of[kBlock];
-  for (int i = 0; i < n; ++i) fault_of[i] = PointFault::None;
-  if (b.fault_index >= 0) fault_of[b.fault_index] = b.fault;
-  int idx[kBlock];
-  Sym g_sigma[kBlock];
-  double g_rho[kBlock], g_e[kBlock], g_ep[kBlock], g_T[kBlock], g_m[kBlock], g_c[kBlock];
-  std::uint8_t g_f[kBlock];
-  Mat3 g_L[kBlock];
+  for (int i = 0; i < n; ++i) it.fault_of[i] = PointFault::None;
+  if (b.fault_index >= 0) it.fault_of[b.fault_index] = b.fault;
   for (int pass = 1; pass < kPlaneStressMaxPasses; ++pass) {
-    int k = 0;
-    for (int i = 0; i < n; ++i) {
-      if (done[i]) continue;
-      const Sym& s = b.sigma[i];
-      const double r = s[2];
-      const double rate_scale =
-          std::abs(L[i](0, 0)) + std::abs(L[i](1, 1)) + std::abs(L[i](0, 1)) + std::abs(d[i]);
-      // Converged: sigma_zz below 1e-12 of the stress, or within a few units of round-off of
-      // a stress from the density (M x 1e-16: a particle at rest under noise-level stresses has
-      // nothing finer to converge to), or not finite (the update reports that).
-      const double scale =
-          std::max({std::abs(s[0]), std::abs(s[1]), std::abs(s[5])}) + k0 * rate_scale;
-      if (!(std::abs(r) > 1e-12 * scale + 1e-15 * M) || !std::isfinite(r)) {
-        done[i] = true;
-        continue;
-      }
-      if (r > 0) {
-        if (side[i] == 1) r_lo[i] *= 0.5;  // Illinois: the other end was kept twice
-        hi[i] = d[i], r_hi[i] = r, side[i] = 1;
-      } else {
-        if (side[i] == -1) r_hi[i] *= 0.5;
-        lo[i] = d[i], r_lo[i] = r, side[i] = -1;
-      }
-      double next;
-      if (lo[i] > -inf && hi[i] < inf) {
-        next = (lo[i] * r_hi[i] - hi[i] * r_lo[i]) / (r_hi[i] - r_lo[i]);
-        if (!(next > lo[i] && next < hi[i])) next = 0.5 * (lo[i] + hi[i]);
-        // No root left to find: a jump of sigma_zz(d) (the EOS's thermal term switching off
-        // at rho0), or a bracket narrower than a representable change of the density.
-        if (hi[i] - lo[i] <= 1e-9 * rate_scale || (hi[i] - lo[i]) * b.dt <= 1e-15) done[i] = true;
-      } else {
-        next = d[i] - r / k0;
-        if (pass > 1 && r != r_prev[i] && d[i] != d_prev[i]) {
-          const double slope = (r - r_prev[i]) / (d[i] - d_prev[i]);
-          if (slope > 0) next = d[i] - r / slope;
-        }
-      }
-      d_prev[i] = d[i];
-      r_prev[i] = r;
-      if (std::abs(next - d[i]) <= 1e-13 * rate_scale || std::abs(next - d[i]) * b.dt <= 1e-16)
-        done[i] = true;  // a step at round-off
-      if (done[i]) continue;
-      d[i] = next;
-      idx[k++] = i;
-    }
+    int idx[kBlock], k = 0;
+    for (int i = 0; i < n; ++i)
+      if (!it.root[i].done && it.root[i].advance(b.sigma[i], it.L[i], M, k0, b.dt, pass))
+        idx[k++] = i;
     if (k == 0) break;
-    // Update the sub-block of the particles still iterating from their state of t^n.
-    MaterialBlock g = b;
-    g.n = k;
-    g.L = g_L;
-    g.m = g_m;
-    g.sigma = g_sigma;
-    g.rho = g_rho;
-    g.e = g_e;
-    g.eps_p = b.eps_p ? g_ep : nullptr;
-    g.T = b.T ? g_T : nullptr;
-    g.failed = b.failed ? g_f : nullptr;
-    g.c = g_c;
-    g.thickness = nullptr;
-    g.fault_index = -1;
-    g.fault = PointFault::None;
-    for (int j = 0; j < k; ++j) {
-      const int i = idx[j];
-      L[i](2, 2) = d[i];
-      g_L[j] = L[i];
-      g_m[j] = b.m[i];
-      g_sigma[j] = sigma0[i];
-      g_rho[j] = rho0[i];
-      g_e[j] = e0[i];
-      if (b.eps_p) g_ep[j] = ep0[i];
-      if (b.T) g_T[j] = T0[i];
-      if (b.failed) g_f[j] = f0[i];
-      fault_of[i] = PointFault::None;
-    }
-    update_once(g, S);
-    if (g.fault_index >= 0) fault_of[idx[g.fault_index]] = g.fault;
-    for (int j = 0; j < k; ++j) {
-      const int i = idx[j];
-      b.sigma[i] = g_sigma[j];
-      b.rho[i] = g_rho[j];
-      b.e[i] = g_e[j];
-      if (b.eps_p) b.eps_p[i] = g_ep[j];
-      if (b.T) b.T[i] = g_T[j];
-      if (b.failed) b.failed[i] = g_f[j];
-      b.c[i] = g_c[j];
-    }
+    update_iterating(b, it, idx, k, S);
   }
   b.fault_index = -1;
   b.fault = PointFault::None;
   for (int i = 0; i < n && b.fault_index < 0; ++i)
-    if (fault_of[i] != PointFault::None) b.fault_index = i, b.fault = fault_of[i];
+    if (it.fault_of[i] != PointFault::None) b.fault_index = i, b.fault = it.fault_of[i];
   b.L = L_in;
   if (b.thickness)  // as the density: V_new = V_old (1 + tr(D) dt), of which (1 + d dt) across
-    for (int i = 0; i < n; ++i) b.thickness[i] *= 1.0 + L[i](2, 2) * b.dt;
+    for (int i = 0; i < n; ++i) b.thickness[i] *= 1.0 + it.L[i](2, 2) * b.dt;
+}
+
+// Updates the sub-block of the particles idx[0, k) still iterating from their state of t^n,
+// at their next rates, into the block b.
+void Material::update_iterating(MaterialBlock& b, PlaneStressIteration& it, const int* idx, int k,
+                                BlockScratch& S) const {
+  Sym g_sigma[kBlock];
+  double g_rho[kBlock], g_e[kBlock], g_ep[kBlock], g_T[kBlock], g_m[kBlock], g_c[kBlock];
+  std::uint8_t g_f[kBlock];
+  Mat3 g_L[kBlock];
+  MaterialBlock g = b;
+  g.n = k;
+  g.L = g_L;
+  g.m = g_m;
+  g.set_state(g_sigma, g_rho, g_e, b.eps_p ? g_ep : nullptr, b.T ? g_T : nullptr,
+              b.failed ? g_f : nullptr, nullptr, 0);
+  g.c = g_c;
+  g.fault_index = -1;
+  g.fault = PointFault::None;
+  for (int j = 0; j < k; ++j) {
+    const int i = idx[j];
+    it.L[i](2, 2) = it.root[i].d;
+    g_L[j] = it.L[i];
+    g_m[j] = b.m[i];
+    copy_state(it.start, i, g, j);
+    it.fault_of[i] = PointFault::None;
+  }
+  update_once(g, S);
+  if (g.fault_index >= 0) it.fault_of[idx[g.fault_index]] = g.fault;
+  for (int j = 0; j < k; ++j) {
+    const int i = idx[j];
+    copy_state(g, j, b, i);
+    b.c[i] = g_c[j];
+  }
 }
 
 void Material::update_once(MaterialBlock& b, BlockScratch& S) const {

@@ -3,6 +3,7 @@
 /// chosen by name from the scene. The solver calls Material::update once per block of
 /// particles of one material (never once per particle); the strength and EOS are called once
 /// per block too.
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -16,6 +17,12 @@ namespace mpm {
 
 /// Largest number of particles in one block.
 inline constexpr int kBlock = 64;
+
+/// The stable explicit step (s) for the fastest signal `speed` (m/s) on cells of size h (m):
+/// min(dt_max, cfl h / speed), dt_max when nothing moves (speed 0).
+inline double stable_time_step(double dt_max, double cfl, double h, double speed) {
+  return std::min(dt_max, speed > 0 ? cfl * h / speed : dt_max);
+}
 
 /// Why a particle's update failed (instability diagnosis).
 enum class PointFault : std::uint8_t { None, VolumeInverted, NonFinite };
@@ -42,7 +49,33 @@ struct MaterialBlock {
       nullptr;           ///< plane stress: thickness / initial thickness (in/out; may be null)
   int fault_index = -1;  ///< out: first particle whose update failed, -1 if none
   PointFault fault = PointFault::None;
+
+  /// Points the state at columns from their element i0 (the optional ones null when absent).
+  void set_state(Sym* sigma_, double* rho_, double* e_, double* eps_p_, double* T_,
+                 std::uint8_t* failed_, double* thickness_, std::size_t i0) {
+    sigma = sigma_ + i0;
+    rho = rho_ + i0;
+    e = e_ + i0;
+    eps_p = eps_p_ ? eps_p_ + i0 : nullptr;
+    T = T_ ? T_ + i0 : nullptr;
+    failed = failed_ ? failed_ + i0 : nullptr;
+    thickness = thickness_ ? thickness_ + i0 : nullptr;
+  }
 };
+
+/// Copies the state (sigma, rho, e and, where both have them, eps_p, T, failed and
+/// thickness) of element i of `from` to element j of `to`: particle columns (ParticleView) or
+/// a block (MaterialBlock).
+template <class From, class To>
+void copy_state(const From& from, std::size_t i, const To& to, std::size_t j) {
+  to.sigma[j] = from.sigma[i];
+  to.rho[j] = from.rho[i];
+  to.e[j] = from.e[i];
+  if (from.eps_p && to.eps_p) to.eps_p[j] = from.eps_p[i];
+  if (from.T && to.T) to.T[j] = from.T[i];
+  if (from.failed && to.failed) to.failed[j] = from.failed[i];
+  if (from.thickness && to.thickness) to.thickness[j] = from.thickness[i];
+}
 
 /// Scratch shared by the stages of one block update (owned by the caller, one per thread).
 struct BlockScratch {
@@ -114,6 +147,9 @@ class Material {
  private:
   void update_once(MaterialBlock& blk, BlockScratch& S) const;
   void update_plane_stress(MaterialBlock& blk, BlockScratch& S) const;
+  struct PlaneStressIteration;
+  void update_iterating(MaterialBlock& b, PlaneStressIteration& it, const int* idx, int k,
+                        BlockScratch& S) const;
 
   MaterialSpec spec_;
   double G_ = 0, K_ = 0;

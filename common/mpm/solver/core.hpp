@@ -1,0 +1,319 @@
+#pragma once
+/// The solver core the explicit and implicit solvers are built on (each derives from
+/// SolverCore): the particles in cell order on their grid, the materials, rigid bodies and
+/// the forces on the supports, the energy balance with its guard, the particles that leave
+/// the domain, the nodal-mass floor and the stable step of the initial state.
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mpm/core/columns.hpp"
+#include "mpm/core/error.hpp"
+#include "mpm/core/timers.hpp"
+#include "mpm/grid/binning.hpp"
+#include "mpm/grid/grid.hpp"
+#include "mpm/scene/particles.hpp"
+#include "mpm/scene/scene.hpp"
+#include "mpm/solver/balance.hpp"
+#include "mpm/solver/materials/material.hpp"
+
+namespace mpm {
+
+/// A run that went unstable: the step, the particle (its id) and the cause.
+class InstabilityError : public std::runtime_error {
+ public:
+  InstabilityError(long step, double time, long particle, const std::string& cause);
+  long step;
+  double time;
+  long particle;  ///< particle id, -1 when the cause is global (energy growth)
+  std::string cause;
+};
+
+/// Prescribed velocities of the scene's rigid bodies, by body (zero for deformable bodies);
+/// returns whether the scene has a rigid body.
+template <int D>
+bool rigid_body_velocities(const Scene& scene, std::vector<Vec<D>>& velocity) {
+  velocity.assign(scene.bodies.size(), Vec<D>::Zero());
+  bool any = false;
+  for (std::size_t b = 0; b < scene.bodies.size(); ++b)
+    if (scene.bodies[b].rigid) {
+      any = true;
+      for (int a = 0; a < D; ++a) velocity[b][a] = scene.bodies[b].velocity[a];
+    }
+  return any;
+}
+
+/// The velocity components each rigid body imposes on the nodes it touches, as bits (bit a:
+/// axis a): all of them for no-slip contact, the others than its `slip` axes otherwise.
+template <int D>
+std::vector<std::uint8_t> rigid_body_held(const Scene& scene) {
+  constexpr std::uint8_t all = (1u << D) - 1;
+  std::vector<std::uint8_t> held(scene.bodies.size(), 0);
+  for (std::size_t b = 0; b < scene.bodies.size(); ++b)
+    if (scene.bodies[b].rigid) held[b] = std::uint8_t(all & ~scene.bodies[b].slip_axes);
+  return held;
+}
+
+/// Checks that every particle starts inside the grid's domain (InputError naming the first
+/// that does not) and returns the nodal-mass floor below which a node counts as empty: 1e-14
+/// of the lightest deformable particle.
+template <Grid GridT>
+double check_start_and_mass_floor(const GridT& grid, const ParticleView<GridT::kDim>& p) {
+  double m_min = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < p.n; ++i) {
+    std::int64_t key;
+    Vec<GridT::kDim> xi;
+    if (!p.x[i].allFinite() || grid.where(p.x[i], key, xi) == Where::OutsideDomain)
+      throw InputError(
+          "model", "particle " + std::to_string(p.id[i]) + " lies outside the domain of the grid");
+    if (p.material[i] != kRigidMaterial) m_min = std::min(m_min, p.m[i]);
+  }
+  return 1e-14 * (std::isfinite(m_min) ? m_min : 1.0);
+}
+
+/// Per-thread scratch of the constitutive update.
+struct StressScratch {
+  Mat3 L[kBlock];  ///< velocity gradients of the block, 1/s
+  double c[kBlock];
+  BlockScratch S;
+};
+
+/// A run [i0, i0 + k) of particles of one material and one cell size waiting for their
+/// material update (which runs once per block, never once per particle).
+struct PendingBlock {
+  std::uint32_t i0 = 0;
+  int k = 0;
+  int mat = -1;
+  double h = 0;  ///< cell size, m
+  /// True when particle i of material `mat_i` in a cell of size `h_i` cannot join: another
+  /// material or cell size, a full block, or a gap (a skipped rigid particle ends a block).
+  bool ends_before(std::uint32_t i, int mat_i, double h_i) const {
+    return mat_i != mat || k == kBlock || i != i0 + std::uint32_t(k) || h_i != h;
+  }
+  /// Starts the next block at particle i (after the pending one was updated).
+  void restart(std::uint32_t i, int mat_i, double h_i) {
+    mat = mat_i;
+    i0 = i;
+    h = h_i;
+  }
+};
+
+/// The state and bookkeeping both solvers share; ExplicitSolver and ImplicitSolver derive
+/// from it and add their step and kernels. Its accessors are the solvers' common interface.
+template <Grid GridT>
+class SolverCore {
+ public:
+  static constexpr int D = GridT::kDim;
+
+  double time() const { return time_; }
+  long steps() const { return steps_; }
+  /// Particle count times steps taken, for throughput figures.
+  double particle_steps() const { return particle_steps_; }
+  const Balance& balance() const { return balance_; }
+  /// Energy scale for the growth check: the largest of |total(0)|, kinetic and |work| so far.
+  double energy_scale() const { return energy_scale_; }
+  /// Force (N) carried by each constrained face in the last step, positive when the material
+  /// pushes against it; faces in the order x_min, x_max, y_min, y_max, z_min, z_max.
+  /// Per metre in plane strain, per radian in axisymmetry.
+  const std::array<double, 6>& face_force() const { return face_force_; }
+  /// Force (N) the material exerts on each rigid body in the last step (zero for the others),
+  /// indexed by body.
+  const std::vector<Vec3>& rigid_force() const { return rigid_force_; }
+  ColumnStore& particles() { return particles_; }
+  const GridT& grid() const { return grid_; }
+  const Binning& binning() const { return binning_; }
+  KernelTimers& timers() { return timers_; }
+  std::size_t removed_particles() const { return removed_count_; }
+  const Scene& scene() const { return scene_; }
+
+ protected:
+  /// Takes the particles (columns as written by mpm-prep; state columns are added) and a grid
+  /// built for the scene; checks that they start in the domain. The columns stay the caller's.
+  SolverCore(const Scene& scene, GridT grid, ColumnStore& particles);
+  ~SolverCore() = default;
+
+  /// Cell order: particles that left the domain are dropped (their energy booked), the grid
+  /// window refitted to the others, the columns sorted by cell.
+  void sort_particles();
+  /// The initial energies (the reference of the energy guard); returns the stable step of
+  /// the initial state, min(dt_max, cfl h / max_p(c_p + |v_p|)).
+  double start_energies();
+  /// The clock after a step of dt (s), then the energy guard: InstabilityError when the
+  /// energy grew beyond solver.energy_growth_limit of its scale, suggesting `remedy`.
+  void end_step(double dt, const char* remedy);
+  /// Where particle i (of the bin of cell `bin_key`) went when it moved to x: out of the
+  /// domain, out of the window, out of its bin's cell or slab layer, or to a non-finite x.
+  void track_move(const Vec<D>& x, std::uint32_t i, std::int64_t bin_key, ChunkSums& s) const;
+  /// Adds each chunk's sums to `total`, in chunk order; throws on the first fault, and on a
+  /// particle that left the domain unless solver.on_exit = "remove" (then it is kept in
+  /// exits_ for the next sort).
+  void reduce(const std::vector<ChunkSums>& chunks, ChunkSums& total);
+  /// The material update of the pending block of the particles s (their own columns, or a
+  /// trial copy of the state), velocity gradients in scr.L; returns the block (signal speeds
+  /// in scr.c, faults).
+  MaterialBlock update_block(const PendingBlock& pb, const ParticleView<D>& s,
+                             StressScratch& scr) const;
+  /// Books the force F (N) the material exerts on rigid body `body` along `axis` in a step
+  /// and the work the body does on the material.
+  void book_rigid_force(int body, int axis, double F) {
+    rigid_force_[body][axis] += F;
+    balance_.external_work -= dt_ * F * rigid_velocity_[body][axis];
+  }
+  bool rigid(std::uint32_t i) const { return material_[i] == kRigidMaterial; }
+
+  Scene scene_;
+  ColumnStore& particles_;
+  GridT grid_;
+  Binning binning_;
+  std::vector<Material> materials_;
+  bool axisymmetric_ = false;
+  bool plane_stress_ = false;  ///< 2D: sigma_zz = 0 (the material update solves for L_zz)
+  bool has_rigid_ = false;
+  std::vector<Vec<D>> rigid_velocity_;    ///< by body; zero for deformable bodies
+  std::vector<std::uint8_t> rigid_held_;  ///< by body: the components it imposes (bits)
+  std::vector<Vec3> rigid_force_;
+  Vec<D> gravity_ = Vec<D>::Zero();
+  double dt_ = 0, time_ = 0;  ///< s: the step being taken, the time reached
+  long steps_ = 0;
+  double particle_steps_ = 0;
+  bool need_sort_ = true;
+  const std::uint8_t* material_ = nullptr;  ///< refreshed with every view
+  std::vector<std::uint32_t> exits_;  ///< particles that left the domain, removed at next sort
+  std::size_t removed_count_ = 0;
+  Balance balance_;
+  double total0_ = 0, energy_scale_ = 0;
+  std::array<double, 6> face_force_{};
+  double node_mass_floor_ = 0;                           ///< nodes lighter count as empty
+  std::vector<std::unique_ptr<StressScratch>> scratch_;  ///< per thread
+  mutable KernelTimers timers_;  ///< const kernels (residual, fold check) are timed too
+};
+
+/// "total energy grew by ..." for the energy guard.
+std::string energy_growth_message(double growth, double scale, double limit, const char* remedy);
+/// "left the domain at (x, y, z) m ..." for a particle that left with on_exit = "stop".
+std::string exit_message(const double* x, int dim);
+
+template <Grid GridT>
+SolverCore<GridT>::SolverCore(const Scene& scene, GridT grid, ColumnStore& particles)
+    : scene_(scene),
+      particles_(particles),
+      grid_(std::move(grid)),
+      axisymmetric_(D == 2 && scene.axisymmetric),
+      plane_stress_(D == 2 && scene.plane_stress) {
+  prepare_columns(particles_, scene_);
+  for (const auto& m : scene_.materials) materials_.emplace_back(m, scene_.solver);
+  for (int a = 0; a < D; ++a) gravity_[a] = scene_.solver.gravity[a];
+  has_rigid_ = rigid_body_velocities<D>(scene_, rigid_velocity_);
+  rigid_held_ = rigid_body_held<D>(scene_);
+  rigid_force_.assign(scene_.bodies.size(), Vec3::Zero());
+  scratch_.resize(omp_get_max_threads());
+  for (auto& s : scratch_) s = std::make_unique<StressScratch>();
+  const ParticleView<D> p = view<D>(particles_);
+  material_ = p.material;
+  node_mass_floor_ = check_start_and_mass_floor(grid_, p);
+}
+
+template <Grid GridT>
+void SolverCore<GridT>::sort_particles() {
+  ScopedTimer timer(timers_, timers_.id("sort"));
+  removed_count_ += account_exits<D>(particles_, exits_, balance_);
+  binning_.sort(particles_, grid_, exits_);
+  exits_.clear();
+  need_sort_ = false;
+  material_ = view<D>(particles_).material;
+}
+
+template <Grid GridT>
+double SolverCore<GridT>::start_energies() {
+  const double speed = start_balance<D>(view<D>(particles_), materials_, balance_);
+  total0_ = balance_.leapfrog_total = balance_.total();
+  energy_scale_ = std::max(std::abs(total0_), balance_.kinetic);
+  return stable_time_step(scene_.solver.dt_max, scene_.solver.cfl, grid_.min_cell_size(), speed);
+}
+
+template <Grid GridT>
+void SolverCore<GridT>::end_step(double dt, const char* remedy) {
+  time_ += dt;
+  ++steps_;
+  particle_steps_ += double(particles_.size());
+  // The energy guard.
+  energy_scale_ = std::max({energy_scale_, balance_.kinetic, std::abs(balance_.external_work)});
+  const double growth = balance_.leapfrog_total - total0_;
+  const double limit = scene_.solver.energy_growth_limit;
+  if (growth > limit * energy_scale_ && energy_scale_ > 0)
+    throw InstabilityError(steps_, time_, -1,
+                           energy_growth_message(growth, energy_scale_, limit, remedy));
+}
+
+template <Grid GridT>
+void SolverCore<GridT>::track_move(const Vec<D>& x, std::uint32_t i, std::int64_t bin_key,
+                                   ChunkSums& s) const {
+  if (!x.allFinite()) {
+    if (s.fault < 0) s.fault = i, s.cause = "its position is not finite";
+    return;
+  }
+  std::int64_t key = -1;
+  Vec<D> xi;
+  switch (grid_.where(x, key, xi)) {
+    case Where::OutsideDomain:
+      s.exits.push_back(i);
+      break;
+    case Where::OutsideWindow:
+      s.out_of_window = true;
+      break;
+    case Where::Window:
+      if (key != bin_key) {
+        ++s.off_bin;
+        if (grid_.layer(key) != grid_.layer(bin_key)) ++s.strays;
+      }
+      break;
+  }
+}
+
+template <Grid GridT>
+void SolverCore<GridT>::reduce(const std::vector<ChunkSums>& chunks, ChunkSums& total) {
+  const ParticleView<D> p = view<D>(particles_);
+  for (const ChunkSums& s : chunks) {
+    if (s.fault >= 0) throw InstabilityError(steps_ + 1, time_ + dt_, p.id[s.fault], s.cause);
+    total.internal += s.internal;
+    total.dt_min = std::min(total.dt_min, s.dt_min);
+    total.kinetic += s.kinetic;
+    total.leapfrog_kinetic += s.leapfrog_kinetic;
+    total.work += s.work;
+    total.momentum += s.momentum;
+    total.off_bin += s.off_bin;
+    total.strays += s.strays;
+    total.out_of_window = total.out_of_window || s.out_of_window;
+    for (auto i : s.exits) {
+      if (scene_.solver.on_exit == OnExit::Stop)
+        throw InstabilityError(steps_ + 1, time_ + dt_, p.id[i], exit_message(p.x[i].data(), D));
+      exits_.push_back(i);
+    }
+  }
+}
+
+template <Grid GridT>
+MaterialBlock SolverCore<GridT>::update_block(const PendingBlock& pb, const ParticleView<D>& s,
+                                              StressScratch& scr) const {
+  MaterialBlock blk;
+  blk.n = pb.k;
+  blk.dt = dt_;
+  blk.h = pb.h;
+  blk.L = scr.L;
+  blk.m = s.m + pb.i0;
+  blk.set_state(s.sigma, s.rho, s.e, s.eps_p, s.T, s.failed, s.thickness, pb.i0);
+  blk.c = scr.c;
+  blk.plane_stress = plane_stress_;
+  materials_[pb.mat].update(blk, scr.S);
+  return blk;
+}
+
+}  // namespace mpm

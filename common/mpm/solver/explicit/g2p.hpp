@@ -1,0 +1,135 @@
+#pragma once
+// Grid to particle: velocity (000, eqs. 8, 10), position when moving (eqs. 7, 9), and for
+// MUSL the remapped momentum m_p v_p back to the grid (eq. 11), a scatter (scatter.hpp).
+// Rigid particles keep their velocity and, when moving, advance with it.
+#include <omp.h>
+
+#include <algorithm>
+
+#include "mpm/solver/explicit/explicit_solver.hpp"
+
+namespace mpm {
+
+template <Grid GridT>
+template <typename ExplicitSolver<GridT>::G2pMode M>
+void ExplicitSolver<GridT>::g2p() {
+  constexpr bool kRemapped = M == G2pMode::Remap, kMove = M == G2pMode::Move;
+  ScopedTimer timer(timers_, timers_.id(kRemapped ? "g2p_remap" : kMove ? "g2p_move" : "g2p"));
+  const ParticleView<D> p = view<D>(particles_);
+  material_ = p.material;
+  const Vec<D>* a_i = grid_.a.data();
+  const Vec<D>* v_i = grid_.v.data();
+  const auto& bins = binning_.bins();
+  const int nchunks = binning_.chunk_count();
+  const double dt = dt_;
+  std::vector<ChunkSums> stats(std::max(nchunks, omp_get_max_threads()));
+
+  auto move_rigid = [&](std::uint32_t i, ChunkSums& s, std::int64_t bin_key) {
+    if constexpr (kMove) {
+      p.x[i] += dt * p.v[i];
+      track_move(p.x[i], i, bin_key, s);
+    }
+  };
+  // One particle on its own: update (when first visited) and remap into a target. The bodies
+  // are flattened (every call inlined), as the kernel's hot loops.
+  auto particle_body = [&] [[gnu::flatten]] (std::uint32_t i, const Target& t, bool first_visit,
+                                             int unit) {
+    std::int64_t key, nd[NMAX];
+    Vec<D> xi;
+    grid_.locate(p.x[i], key, xi);
+    if (first_visit && rigid(i)) {
+      move_rigid(i, stats[unit], key);
+      return;
+    }
+    if (rigid(i)) return;
+    const int nk = grid_.cell_nodes(key, nd);
+    double N[NMAX];
+    if (first_visit)
+      advance_particle<M>(p, i, key, xi, nd, nk, nullptr, nullptr, N, stats[unit], key);
+    else
+      grid_.values(key, xi, N);
+    if constexpr (kRemapped) {
+      const Vec<D> mv = p.m[i] * p.v[i];
+      for (int c = 0; c < nk; ++c) t.q[nd[c] - t.offset] += N[c] * mv;
+    }
+  };
+  // One bin with its cell's nodal values cached.
+  auto bin_body = [&] [[gnu::flatten]] (int ch, std::uint32_t bi, const Target& t,
+                                        std::vector<std::uint32_t>* strays) {
+    ChunkSums& s = stats[ch];
+    const Bin& bin = bins[bi];
+    const int layer = grid_.layer(bin.key);
+    std::int64_t nodes[NMAX], other[NMAX];
+    const int nn = grid_.cell_nodes(bin.key, nodes);
+    Vec<D> a_c[NMAX], v_c[NMAX], q_c[NMAX];
+    for (int c = 0; c < nn; ++c) {
+      a_c[c] = a_i[nodes[c]];
+      if constexpr (kMove) v_c[c] = v_i[nodes[c]];
+      q_c[c].setZero();
+    }
+    for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
+      if (rigid(i)) {
+        move_rigid(i, s, bin.key);
+        continue;
+      }
+      const auto [key, xi, home, nk, nd] = locate_in_bin(bin.key, nodes, nn, p.x[i], other);
+      double N[NMAX];
+      advance_particle<M>(p, i, key, xi, nd, nk, home ? a_c : nullptr, home ? v_c : nullptr, N, s,
+                          bin.key);
+      if constexpr (kRemapped) {
+        const Vec<D> mv = p.m[i] * p.v[i];
+        if (home) {
+          for (int c = 0; c < nk; ++c) q_c[c] += N[c] * mv;
+        } else if (!strays || grid_.layer(key) == layer) {
+          for (int c = 0; c < nk; ++c) t.q[nd[c] - t.offset] += N[c] * mv;
+        } else {
+          strays->push_back(i);
+        }
+      }
+    }
+    if constexpr (kRemapped)
+      for (int c = 0; c < nn; ++c) t.q[nodes[c] - t.offset] += q_c[c];
+  };
+
+  if constexpr (kRemapped) {
+    scatter(kRemap, bin_body, particle_body);
+  } else {  // a gather: any chunk on any thread
+    const auto& chunks = binning_.chunks();
+    const Target none{nullptr, nullptr, nullptr, nullptr, 0};
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int ch = 0; ch < nchunks; ++ch)
+      for (std::uint32_t bi = chunks[ch].bin_begin; bi < chunks[ch].bin_end; ++bi)
+        bin_body(ch, bi, none, nullptr);
+  }
+  finish(stats, kMove ? kVelocities | kPositions : kVelocities);
+}
+
+/// The velocity (and when moving, position) update of particle i, in cell `key` at local
+/// coordinates xi, from the nodal values at the nodes nd of its cell (a_c, v_c: cached
+/// copies, or null to read the grid); returns its shape function values in N for the remap.
+template <Grid GridT>
+template <typename ExplicitSolver<GridT>::G2pMode M>
+void ExplicitSolver<GridT>::advance_particle(const ParticleView<D>& p, std::uint32_t i,
+                                             std::int64_t key, const Vec<D>& xi,
+                                             const std::int64_t* nd, int nk, const Vec<D>* a_c,
+                                             const Vec<D>* v_c, double* N, ChunkSums& s,
+                                             std::int64_t bin_key) const {
+  constexpr bool kMove = M == G2pMode::Move;
+  const double dt = dt_;
+  grid_.values(key, xi, N);
+  Vec<D> a_p = Vec<D>::Zero(), vbar = Vec<D>::Zero();
+  for (int c = 0; c < nk; ++c) {
+    a_p += N[c] * (a_c ? a_c[c] : grid_.a[nd[c]]);
+    if constexpr (kMove) vbar += N[c] * (v_c ? v_c[c] : grid_.v[nd[c]]);
+  }
+  const Vec<D> v_old = p.v[i];
+  p.v[i] += dt * a_p;  // (000, eq. 8)
+  s.leapfrog_kinetic += 0.5 * p.m[i] * v_old.dot(p.v[i]);
+  if constexpr (kMove) {
+    p.x[i] += dt * vbar;  // (000, eq. 7)
+    s.add_motion(p, i, dt, gravity_);
+    track_move(p.x[i], i, bin_key, s);
+  }
+}
+
+}  // namespace mpm

@@ -1,0 +1,126 @@
+#pragma once
+// Particle to grid (000, eqs. 1-5): lumped mass, momentum, internal force, body forces and
+// loads. A particle in its bin's cell adds into registers flushed once per cell.
+#include "mpm/solver/explicit/explicit_solver.hpp"
+
+namespace mpm {
+
+template <Grid GridT>
+template <int F>
+void ExplicitSolver<GridT>::p2g() {
+  ScopedTimer timer(timers_, timers_.id(F == kForce    ? "p2g_force"
+                                        : (F & kForce) ? "p2g"
+                                                       : "p2g_mass_momentum"));
+  constexpr bool kM = F & kMass, kP = F & kMomentum, kF = F & kForce;
+  if constexpr (kM) {
+    grid_.clear(scheme_ == Scheme::MUSL, has_rigid_);
+    if (has_rigid_) mark_rigid_nodes();
+  }
+  const ParticleView<D> p = view<D>(particles_);
+  material_ = p.material;
+  const auto& bins = binning_.bins();
+  const Vec<D> b = gravity_;
+  const bool axi = axisymmetric_;
+
+  // Contribution of particle i (cell `key`, local coordinates xi) through add(c, dm, dp, df).
+  auto contribute = [&](std::uint32_t i, std::int64_t key, const Vec<D>& xi, int nn, auto&& add) {
+    double N[NMAX];
+    Vec<D> G[NMAX];
+    if constexpr (kF)
+      grid_.shape(key, xi, N, G);
+    else
+      grid_.values(key, xi, N);
+    const double m_p = p.m[i];
+    const Vec<D> mv_p = m_p * p.v[i];
+    Mat<D> Vsigma = Mat<D>::Zero();  // V_p sigma_p, in-plane part
+    double Vs_hoop_r = 0;            // axisymmetric: V_p sigma_thetatheta / r_p
+    Vec<D> fb = m_p * b;             // body force and load
+    if constexpr (kF) {
+      const double V = m_p / p.rho[i];
+      Vsigma = V * to_matrix(p.sigma[i]).template topLeftCorner<D, D>();
+      if (axi) Vs_hoop_r = V * p.sigma[i][2] / p.x[i][0];
+      if (p.f_ext) fb += p.f_ext[i];
+    }
+    for (int c = 0; c < nn; ++c) {
+      Vec<D> df = Vec<D>::Zero();
+      if constexpr (kF) {
+        df = N[c] * fb - Vsigma * G[c];      // (000, eqs. 4-5)
+        if (axi) df[0] -= Vs_hoop_r * N[c];  // hoop stress (Sulsky & Schreyer 1996)
+      }
+      add(c, m_p * N[c], N[c] * mv_p, df);
+    }
+  };
+  // Writes into a target at the nodes of a cell.
+  auto to_target = [&](const Target& t, const std::int64_t* nodes) {
+    return [&t, nodes](int c, double dm, const Vec<D>& dp, const Vec<D>& df) {
+      const std::int64_t n = nodes[c] - t.offset;
+      if constexpr (kM) t.m[n] += dm;
+      if constexpr (kP) t.v[n] += dp;
+      if constexpr (kF) t.a[n] += df;
+    };
+  };
+  auto particle_body = [&](std::uint32_t i, const Target& t, bool, int) {
+    if (rigid(i)) return;
+    std::int64_t key, nodes[NMAX];
+    Vec<D> xi;
+    grid_.locate(p.x[i], key, xi);
+    const int nn = grid_.cell_nodes(key, nodes);
+    contribute(i, key, xi, nn, to_target(t, nodes));
+  };
+  auto bin_body = [&](int, std::uint32_t bi, const Target& t, std::vector<std::uint32_t>* strays) {
+    const Bin& bin = bins[bi];
+    const int layer = grid_.layer(bin.key);
+    std::int64_t nodes[NMAX];
+    const int nn = grid_.cell_nodes(bin.key, nodes);
+    double m_c[NMAX] = {};
+    Vec<D> p_c[NMAX], f_c[NMAX];
+    for (int c = 0; c < nn; ++c) p_c[c].setZero(), f_c[c].setZero();
+    auto to_cell = [&](int c, double dm, const Vec<D>& dp, const Vec<D>& df) {
+      if constexpr (kM) m_c[c] += dm;
+      if constexpr (kP) p_c[c] += dp;
+      if constexpr (kF) f_c[c] += df;
+    };
+    for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
+      if (rigid(i)) continue;
+      std::int64_t key;
+      Vec<D> xi;
+      locate_in_bin(bin.key, p.x[i], key, xi);
+      if (key == bin.key) {
+        contribute(i, key, xi, nn, to_cell);
+      } else if (!strays || grid_.layer(key) == layer) {
+        std::int64_t other[NMAX];
+        const int nk = grid_.cell_nodes(key, other);
+        contribute(i, key, xi, nk, to_target(t, other));
+      } else {
+        strays->push_back(i);
+      }
+    }
+    for (int c = 0; c < nn; ++c) {
+      const std::int64_t n = nodes[c] - t.offset;
+      if constexpr (kM) t.m[n] += m_c[c];
+      if constexpr (kP) t.v[n] += p_c[c];
+      if constexpr (kF) t.a[n] += f_c[c];
+    }
+  };
+  scatter(F, bin_body, particle_body);  // scatter.hpp
+}
+
+// Rigid particles mark the nodes they touch with their body, serially:
+// they are few, and a node touched by two rigid bodies then takes the later one's mark.
+template <Grid GridT>
+void ExplicitSolver<GridT>::mark_rigid_nodes() {
+  const ParticleView<D> p = view<D>(particles_);
+  for (std::size_t i = 0; i < p.n; ++i) {
+    if (p.material[i] != kRigidMaterial) continue;
+    std::int64_t key, nodes[NMAX];
+    Vec<D> xi;
+    double N[NMAX];
+    grid_.locate(p.x[i], key, xi);
+    grid_.values(key, xi, N);
+    const int nn = grid_.cell_nodes(key, nodes);
+    for (int c = 0; c < nn; ++c)
+      if (N[c] > 0) grid_.rigid[nodes[c]] = std::uint8_t(p.body[i] + 1);
+  }
+}
+
+}  // namespace mpm

@@ -1,0 +1,110 @@
+#pragma once
+// Stress update (000, eqs. 12-15): velocity gradient from the grid (in axisymmetry with the
+// hoop rate v_r / r), then the material update once per block of particles of one material.
+// When moving, positions advance with the grid velocity (000, eqs. 7, 9) in the same pass.
+#include <omp.h>
+
+#include <algorithm>
+
+#include "mpm/solver/explicit/explicit_solver.hpp"
+
+namespace mpm {
+
+template <Grid GridT>
+void ExplicitSolver<GridT>::update_stress(const std::vector<Vec<D>>& v_grad, Positions positions) {
+  ScopedTimer timer(timers_, timers_.id(positions == Positions::Move ? "stress_move" : "stress"));
+  const ParticleView<D> p = view<D>(particles_);
+  material_ = p.material;
+  const int nchunks = binning_.chunk_count();
+  std::vector<ChunkSums> stats(nchunks);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int ch = 0; ch < nchunks; ++ch) stress_chunk(p, ch, v_grad.data(), positions, stats[ch]);
+  finish(stats, positions == Positions::Move ? kStresses | kPositions : kStresses);
+}
+
+/// The stress update of the particles of chunk ch from the grid velocities vg_i (flattened:
+/// every call but the material update's is inlined into its loop).
+template <Grid GridT>
+[[gnu::flatten]] void ExplicitSolver<GridT>::stress_chunk(const ParticleView<D>& p, int ch,
+                                                          const Vec<D>* vg_i, Positions positions,
+                                                          ChunkSums& s) {
+  StressScratch& scr = *scratch_[omp_get_thread_num()];
+  const Vec<D>* v_i = grid_.v.data();
+  const auto& bins = binning_.bins();
+  const auto& chunks = binning_.chunks();
+  const double dt = dt_;
+  const bool axi = axisymmetric_, move = positions == Positions::Move;
+  PendingBlock pb;
+  for (std::uint32_t bi = chunks[ch].bin_begin; bi < chunks[ch].bin_end; ++bi) {
+    const Bin& bin = bins[bi];
+    std::int64_t nodes[NMAX], other[NMAX];
+    const int nn = grid_.cell_nodes(bin.key, nodes);
+    Vec<D> vg_c[NMAX], v_c[NMAX];
+    for (int c = 0; c < nn; ++c) {
+      vg_c[c] = vg_i[nodes[c]];
+      if (move) v_c[c] = v_i[nodes[c]];
+    }
+    const double h_cell = grid_.cell_size(bin.key);
+    for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
+      if (rigid(i)) {  // no stress; advances with its own velocity
+        if (move) {
+          p.x[i] += dt * p.v[i];
+          track_move(p.x[i], i, bin.key, s);
+        }
+        continue;
+      }
+      const auto [key, xi, home, nk, nd] = locate_in_bin(bin.key, nodes, nn, p.x[i], other);
+      double N[NMAX];
+      Vec<D> G[NMAX];
+      grid_.shape(key, xi, N, G);
+      // Velocity gradient L = sum_i v_i (x) G_ip (000, eqs. 12-13 use its parts).
+      Mat<D> L = Mat<D>::Zero();
+      Vec<D> vbar = Vec<D>::Zero();
+      double v_r = 0;
+      for (int c = 0; c < nk; ++c) {
+        const Vec<D>& vg = home ? vg_c[c] : vg_i[nd[c]];
+        L.noalias() += vg * G[c].transpose();
+        if (axi) v_r += N[c] * vg[0];
+        if (move) vbar += N[c] * (home ? v_c[c] : v_i[nd[c]]);
+      }
+      if (p.strain) p.strain[i] += dt * L.diagonal();  // for splitting (004, eq. 23)
+      if (pb.ends_before(i, p.material[i], h_cell)) {
+        stress_block(p, pb, scr, s);
+        pb.restart(i, p.material[i], h_cell);
+      }
+      scr.L[pb.k].setZero();
+      scr.L[pb.k].template topLeftCorner<D, D>() = L;
+      if (axi) scr.L[pb.k](2, 2) = v_r / p.x[i][0];  // hoop rate
+      ++pb.k;
+      if (move) {
+        p.x[i] += dt * vbar;  // (000, eq. 7)
+        s.add_motion(p, i, dt, gravity_);
+        track_move(p.x[i], i, bin.key, s);
+      }
+    }
+  }
+  stress_block(p, pb, scr, s);
+}
+
+/// The material update of the pending block (then empty), its internal energy and stable
+/// steps into s, and the first fault.
+template <Grid GridT>
+void ExplicitSolver<GridT>::stress_block(const ParticleView<D>& p, PendingBlock& pb,
+                                         StressScratch& scr, ChunkSums& s) const {
+  if (pb.k == 0) return;
+  const MaterialBlock blk = update_block(pb, p, scr);
+  for (int j = 0; j < pb.k; ++j) {
+    const std::uint32_t i = pb.i0 + j;
+    s.internal += p.m[i] * p.e[i];
+    s.dt_min = std::min(s.dt_min, pb.h / (scr.c[j] + p.v[i].norm()));
+  }
+  if (blk.fault_index >= 0 && s.fault < 0) {
+    s.fault = pb.i0 + blk.fault_index;
+    s.cause = blk.fault == PointFault::VolumeInverted
+                  ? "its volume became non-positive (1 + tr(D) dt <= 0)"
+                  : "its stress or energy is not finite";
+  }
+  pb.k = 0;
+}
+
+}  // namespace mpm
