@@ -129,7 +129,7 @@ Estimates estimate_run(const Scene& scene, const Lattice& lattice, const ColumnS
   Estimates e;
   signal_speeds(scene, cols, e);
   const double h_min = graded ? graded->h_min : lattice.h;  // the time step's cell
-  e.dt = std::min(scene.solver.dt_max, scene.solver.cfl * h_min / e.speed);
+  e.dt = stable_time_step(scene.solver.dt_max, scene.solver.cfl, h_min, e.speed);
   e.steps = std::ceil(scene.solver.end_time / e.dt);
   const ColumnNeeds need = column_needs(scene);
   const int d = scene.dimension;
