@@ -27,7 +27,7 @@ TaylorResult TaylorMeter::measure(const Frame& frame) const {
   const Column* bc = frame.columns.find(col::body);
   if (!xc || !bc) throw InputError("taylor", "frames need the columns 'x' and 'body'");
   const auto* x = reinterpret_cast<const double*>(xc->data());
-  const auto* body = reinterpret_cast<const std::uint8_t*>(bc->data());
+  const BodyIds body(bc);
   const std::size_t n = frame.columns.size();
   const Column* mc = frame.columns.find(col::m);
   const double* m = mc ? reinterpret_cast<const double*>(mc->data()) : nullptr;
@@ -246,7 +246,7 @@ DebrisMeter::DebrisMeter(const Scene& scene, const Frame& first, const DebrisOpt
   dim_ = xc->info().components;
   const auto* x = reinterpret_cast<const double*>(xc->data());
   const auto* v = reinterpret_cast<const double*>(vc->data());
-  const auto* body = reinterpret_cast<const std::uint8_t*>(bc->data());
+  const BodyIds body(bc);
   const std::size_t n = first.columns.size();
   const int nb = int(scene.bodies.size());
   auto find = [&](const std::string& name, const char* option) {

@@ -16,7 +16,8 @@
 namespace mpm {
 
 inline constexpr std::uint16_t kStreamVersionMajor = 1;  ///< readers refuse other majors
-inline constexpr std::uint16_t kStreamVersionMinor = 1;  ///< readers accept any minor (1: GRID)
+/// Readers accept any minor (1: GRID; 2: the body column u32 in models of more than 255 bodies).
+inline constexpr std::uint16_t kStreamVersionMinor = 2;
 
 /// Record types (little-endian fourcc).
 enum class RecordType : std::uint32_t {
