@@ -16,6 +16,7 @@ struct RunOptions {
   std::string strategy = "colored";    ///< particle-to-grid scatter strategy
   bool deterministic = false;          ///< results independent of the thread count
   ProgressMode progress = ProgressMode::Auto;
+  double max_memory = 0;  ///< bytes the run may need (--max-memory); 0: the machine's memory
 };
 
 /// Runs a model to its end time. Returns the exit status (ExitStatus); errors in the input

@@ -38,7 +38,8 @@ const std::vector<std::string_view> kBodyKeys = {"name",
                                                  "particles_per_cell",
                                                  "particle_spacing",
                                                  "rigid",
-                                                 "slip"};
+                                                 "slip",
+                                                 "cut_by_domain"};
 
 /// The body's material, or none for a rigid body.
 void read_body_material(Reader& r, const Scene& scene, BodySpec& b) {
@@ -192,6 +193,7 @@ BodySpec read_body(Reader& r, const Scene& scene) {
   read_placement(r, scene.dimension, b);
   read_particles(r, b);
   read_slip(r, scene.dimension, b);
+  b.cut_by_domain = r.boolean("cut_by_domain").value_or(false);
   r.finish();
   return b;
 }
