@@ -256,6 +256,8 @@ struct OutputSpec {
   double history_interval = 0;      ///< s; 0: every step
   std::vector<std::string> fields;  ///< particle columns written in frames; empty: all
   Precision precision = Precision::Float64;
+  double checkpoint_time = 0;  ///< s of simulated time between checkpoints; 0: none
+  double checkpoint_wall = 0;  ///< s of wall-clock time between checkpoints; 0: none
 };
 
 struct Scene {
