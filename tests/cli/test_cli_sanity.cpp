@@ -248,7 +248,8 @@ TEST(CliSanity, ModelsAndResultsAreNotTakenForEachOther) {
   EXPECT_EQ(run(post + " particles " + model + " -o /dev/null", dir).status, 0);
   r = run(runner + " --progress none " + result + " -o " + (dir / "again.mpm").string(), dir);
   EXPECT_EQ(r.status, 2) << r.err;
-  expect_all(r.err, {"this is a result from mpm-run, not a model", "no restart"}, "run a result");
+  expect_all(r.err, {"this is a result from mpm-run, not a model", "mpm-run --restart"},
+             "run a result");
   EXPECT_FALSE(fs::exists(dir / "again.mpm") && fs::file_size(dir / "again.mpm") > 100);
 }
 

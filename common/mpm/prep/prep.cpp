@@ -16,6 +16,7 @@
 #include "mpm/grid/sparse_grid.hpp"
 #include "mpm/prep/checks.hpp"
 #include "mpm/prep/graded_voxelise.hpp"
+#include "mpm/prep/initial_fields.hpp"
 #include "mpm/prep/region.hpp"
 #include "mpm/prep/resources.hpp"
 #include "mpm/prep/voxelise.hpp"
@@ -316,6 +317,7 @@ int prepare_model(const PrepOptions& opt) {
   if (!scene.grid.levels.empty()) graded = prepare_graded(scene, lattice, report);
   ColumnStore cols =
       graded ? std::move(graded->columns) : voxelise(scene, lattice, report, progress_cells(scene));
+  apply_initial_fields(scene, cols);  // spin, velocity and stress fields
   const GradedModel* graded_grid = graded ? &*graded : nullptr;
   const std::string text = with_explicit_domain(scene.toml, lattice);
   const Estimates estimates = estimate_run(scene, lattice, cols, graded_grid);
