@@ -253,6 +253,7 @@ int main(int argc, char** argv) {
     if (*history) mpm::require_result(history_args.input, "history");
     if (*taylor) mpm::require_result(taylor_args.input, "taylor");
     if (*debris) mpm::require_result(debris_args.input, "debris");
+    if (*crater) mpm::require_result(crater_args.input, "crater");
     if (*profile) mpm::require_result(profile_args.input, "profile");
     if (*render) mpm::require_result(render_args.input, "render");
     if (*summary) return mpm::post_summary(summary_args);

@@ -237,7 +237,7 @@ TEST(CliSanity, ModelsAndResultsAreNotTakenForEachOther) {
   Result r = run(runner + " --progress none " + model + " -o " + result, dir);
   ASSERT_EQ(r.status, 0) << r.err;
   for (const std::string& cmd :
-       {"history " + model, "taylor " + model + " --axis z", "debris " + model,
+       {"history " + model, "taylor " + model + " --axis z", "debris " + model, "crater " + model,
         "profile " + model + " --field speed --along z", "render " + model + " -o x.png"}) {
     r = run(post + " " + cmd, dir);
     EXPECT_EQ(r.status, 2) << cmd << "\n" << r.err;
