@@ -119,8 +119,11 @@ class History {
       add("residual_evals_total", "-");
     }
   }
+  /// A row for the solver's state now, unless the last row was for this step already.
   template <class Solver>
   void record(const Solver& s, double dt) {
+    if (s.steps() == last_step_) return;
+    last_step_ = s.steps();
     const Balance& b = s.balance();
     // Extensive values as totals: per metre in plane strain, the whole ring in axisymmetry.
     const double k = factor_;
@@ -159,7 +162,8 @@ class History {
   int dim_;
   double factor_;
   bool implicit_;
-  ImplicitWork last_;  ///< totals at the previous row
+  ImplicitWork last_;    ///< totals at the previous row
+  long last_step_ = -1;  ///< step of the last row
   std::vector<int> faces_, rigid_;
   HistoryBlock block_;
 };
@@ -307,8 +311,12 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
         message = "stopped at solver.max_steps = " + std::to_string(max_steps);
         break;
       }
+      const double pace = solver.stable_dt();  // the step taken when no frame time is near
       double dt = next_step(solver, next_frame);
-      solver.step(dt);
+      if constexpr (implicit)
+        solver.step(dt);
+      else
+        solver.step(dt, pace);  // the leapfrog energy evaluated at the pace, not the cut step
       if constexpr (implicit) dt = solver.last_dt();  // cut when Newton failed
       if (solver.time() >= next_history * (1 - 1e-12) || o.history_interval <= 0) {
         history.record(solver, dt);
@@ -316,7 +324,7 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
         if (history.pending() >= 4096) history.flush(out);
       }
       if (solver.time() >= next_frame * (1 - 1e-12)) {
-        if (history.pending() == 0 || o.history_interval > 0) history.record(solver, dt);
+        history.record(solver, dt);  // a row at each frame time (one: record skips a repeat)
         emit_frame(frame == o.frames ? std::uint32_t(kFrameFinal) : 0u);
         ++frame;
         next_frame = frame <= o.frames ? end * frame / o.frames : end;

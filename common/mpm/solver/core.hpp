@@ -288,6 +288,7 @@ void SolverCore<GridT>::reduce(const std::vector<ChunkSums>& chunks, ChunkSums& 
     total.kinetic += s.kinetic;
     total.leapfrog_kinetic += s.leapfrog_kinetic;
     total.work += s.work;
+    total.work_start += s.work_start;
     total.momentum += s.momentum;
     total.off_bin += s.off_bin;
     total.strays += s.strays;
