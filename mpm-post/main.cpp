@@ -97,6 +97,9 @@ CLI::App* add_debris(CLI::App& app, mpm::DebrisArgs& a) {
       ->capture_default_str();
   sub->add_option("--link", a.link,
                   "linking length of fragments, e.g. \"1 mm\" (default: the grid's cell size)");
+  sub->add_flag("--escaped", a.escaped,
+                "also count the particles that left the domain by the frame's time (the run's "
+                "escape records), and those of them that left behind the plane");
   sub->add_option("--expect-front", a.expect_front, "reference front, e.g. \"200 mm\"");
   sub->add_option("--expect-width", a.expect_width, "reference width, e.g. \"145 mm\"");
   sub->add_flag("--json", a.json, "print JSON (SI units)");

@@ -64,6 +64,7 @@ struct DebrisArgs {
   std::string link;              ///< fragments' linking length; empty: the grid's cell size
   double percentile = 99.5;      ///< the headline front and width are this percentile, %
   std::size_t min_fragment = 1;  ///< only fragments of at least this many particles count
+  bool escaped = false;          ///< also count the particles that left the domain (ESCP)
   bool json = false;             ///< print JSON (SI units)
 };
 int post_debris(const DebrisArgs& args);

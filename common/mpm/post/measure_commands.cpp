@@ -5,6 +5,7 @@
 
 #include "mpm/core/error.hpp"
 #include "mpm/post/arguments.hpp"
+#include "mpm/post/column_value.hpp"
 #include "mpm/post/command_io.hpp"
 #include "mpm/post/commands.hpp"
 #include "mpm/post/json.hpp"
@@ -52,7 +53,33 @@ void print_taylor_text(const TaylorResult& r, std::optional<double> eL, std::opt
         r.D_min * 1e3, r.D_max * 1e3, r.D_radius * 1e3);
 }
 
-void print_debris_json(const DebrisResult& r, std::optional<double> ef, std::optional<double> ew) {
+/// The particles that left the domain by the measured frame's time (ESCP records), and those
+/// of them that left downstream of the plane: part of the cloud, gone from the frame.
+struct EscapedCount {
+  std::size_t n = 0, behind = 0;
+  double mass = 0, mass_behind = 0;  ///< kg (whole rings in axisymmetry)
+};
+
+EscapedCount count_escaped(const std::vector<Frame>& records, const DebrisResult& r,
+                           double factor) {
+  EscapedCount c;
+  for (const Frame& f : records) {
+    const Column *x = f.columns.find("x"), *m = f.columns.find("m"), *t = f.columns.find("t_exit");
+    if (!x || !m || !t) continue;
+    for (std::size_t i = 0; i < f.columns.size(); ++i) {
+      if (column_value(*t, i, 0) > r.time * (1 + 1e-12)) continue;
+      const double m_p = factor * column_value(*m, i, 0);
+      const bool behind = r.direction * (column_value(*x, i, r.axis) - r.plane) > 0;
+      ++c.n;
+      c.mass += m_p;
+      if (behind) ++c.behind, c.mass_behind += m_p;
+    }
+  }
+  return c;
+}
+
+void print_debris_json(const DebrisResult& r, std::optional<double> ef, std::optional<double> ew,
+                       const std::optional<EscapedCount>& esc) {
   JsonWriter j;
   j.begin_object().key("time").number(r.time).key("axis").string(std::string(1, "xyz"[r.axis]));
   j.key("direction").integer(r.direction).key("plane").number(r.plane);
@@ -69,6 +96,11 @@ void print_debris_json(const DebrisResult& r, std::optional<double> ef, std::opt
   j.key("percentiles_of").string(r.by_mass ? "mass" : "particles");
   if (ef) j.key("expected_front").number(*ef).key("error_front").number(r.front / *ef - 1);
   if (ew) j.key("expected_width").number(*ew).key("error_width").number(r.width / *ew - 1);
+  if (esc) {
+    j.key("escaped_particles").integer(esc->n).key("escaped_mass").number(esc->mass);
+    j.key("escaped_behind_plane").integer(esc->behind);
+    j.key("escaped_behind_plane_mass").number(esc->mass_behind);
+  }
   j.end_object();
   std::printf("%s\n", j.text().c_str());
 }
@@ -157,8 +189,10 @@ int post_debris(const DebrisArgs& a) {
   std::optional<DebrisResult> chosen;
   double best = 1e300;
   std::size_t frames = 0;
+  std::vector<Frame> escaped;
   StreamVisitor v;
   v.scene = [&](const std::string& t) { scene = scene_of(t, path); };
+  if (a.escaped) v.escapes = [&](Frame&& f) { escaped.push_back(std::move(f)); };
   v.frame = [&](Frame&& f) {
     ++frames;
     if (!scene) throw StreamError(input_name(path), "a frame comes before the scene record");
@@ -177,10 +211,18 @@ int post_debris(const DebrisArgs& a) {
   }
   const std::optional<double> ef = optional_length(a.expect_front, "--expect-front");
   const std::optional<double> ew = optional_length(a.expect_width, "--expect-width");
-  if (a.json)
-    print_debris_json(*chosen, ef, ew);
-  else
+  std::optional<EscapedCount> esc;
+  if (a.escaped) esc = count_escaped(escaped, *chosen, scene->measure_factor());
+  if (a.json) {
+    print_debris_json(*chosen, ef, ew, esc);
+  } else {
     print_debris_text(*chosen, ef, ew);
+    if (esc)
+      std::printf(
+          "  escaped (left the domain by then): %zu particles, %.4g kg; %zu of them, %.4g kg, "
+          "behind the plane\n",
+          esc->n, esc->mass, esc->behind, esc->mass_behind);
+  }
   std::fflush(stdout);
   return conclude(path, s, frames);
 }

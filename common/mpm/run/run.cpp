@@ -96,6 +96,12 @@ class History {
     const char* axes[3] = {"momentum_x", "momentum_y", "momentum_z"};
     for (int a = 0; a < dim; ++a) add(axes[a], "kg m/s");
     add("particles", "-");
+    if (scene.solver.on_exit == OnExit::Remove) {  // what left, so that the totals close
+      removed_ = true;
+      add("removed_mass", "kg");
+      const char* out[3] = {"removed_momentum_x", "removed_momentum_y", "removed_momentum_z"};
+      for (int a = 0; a < dim; ++a) add(out[a], "kg m/s");
+    }
     for (int f = 0; f < 2 * dim; ++f)
       if (bc.face[f] != BoundaryType::Free) {
         faces_.push_back(f);
@@ -132,6 +138,10 @@ class History {
                                k * b.removed,     k * b.total(),  k * b.leapfrog_total};
     for (int a = 0; a < dim_; ++a) row.push_back(k * b.momentum[a]);
     row.push_back(double(const_cast<Solver&>(s).particles().size()));
+    if (removed_) {
+      row.push_back(k * b.removed_mass);
+      for (int a = 0; a < dim_; ++a) row.push_back(k * b.removed_momentum[a]);
+    }
     for (int f : faces_) row.push_back(factor_ * s.face_force()[f]);
     for (int b : rigid_)
       for (int a = 0; a < dim_; ++a) row.push_back(factor_ * s.rigid_force()[b][a]);
@@ -162,8 +172,9 @@ class History {
   int dim_;
   double factor_;
   bool implicit_;
-  ImplicitWork last_;    ///< totals at the previous row
-  long last_step_ = -1;  ///< step of the last row
+  bool removed_ = false;  ///< columns of what left the domain (solver.on_exit = "remove")
+  ImplicitWork last_;     ///< totals at the previous row
+  long last_step_ = -1;   ///< step of the last row
   std::vector<int> faces_, rigid_;
   HistoryBlock block_;
 };
@@ -191,6 +202,34 @@ double next_step(Solver& solver, double next_frame) {
     throw InstabilityError(solver.steps(), solver.time(), -1,
                            "the stable time step is " + std::to_string(dt) + " s");
   return dt;
+}
+
+/// A step of dt (s); the explicit solver evaluates its leapfrog energy at `pace` (s), the
+/// step it would take were no frame time near (ExplicitSolver::step).
+template <class Solver>
+void take_step(Solver& solver, double dt, double pace) {
+  if constexpr (HasImplicitWork<Solver>)
+    solver.step(dt);
+  else
+    solver.step(dt, pace);
+}
+
+/// The particles that left the domain since the last ESCP record (before the next frame), as
+/// an ESCP record stamped with the step and time (s); the log is emptied once written.
+void write_escapes(StreamWriter& out, EscapeLog& log, long step, double time) {
+  if (log.size() == 0) return;
+  Frame e;
+  e.step = step;
+  e.time = time;
+  std::swap(e.columns, log.columns());
+  try {
+    out.write_escapes(e);
+  } catch (...) {
+    std::swap(e.columns, log.columns());
+    throw;
+  }
+  std::swap(e.columns, log.columns());
+  log.clear();
 }
 
 /// The --stats report on stderr: kernel times, throughput, memory and the solver's work; the
@@ -270,6 +309,7 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
   auto emit_frame = [&](std::uint32_t flags) {
     ScopedTimer timer(timers, t_output);
     history.flush(out);
+    write_escapes(out, solver.escapes(), solver.steps(), solver.time());
     emit_grid();
     Frame f;
     f.step = solver.steps();
@@ -313,10 +353,7 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
       }
       const double pace = solver.stable_dt();  // the step taken when no frame time is near
       double dt = next_step(solver, next_frame);
-      if constexpr (implicit)
-        solver.step(dt);
-      else
-        solver.step(dt, pace);  // the leapfrog energy evaluated at the pace, not the cut step
+      take_step(solver, dt, pace);
       if constexpr (implicit) dt = solver.last_dt();  // cut when Newton failed
       if (solver.time() >= next_history * (1 - 1e-12) || o.history_interval <= 0) {
         history.record(solver, dt);
@@ -346,6 +383,7 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
   }
   const double loop_wall = omp_get_wtime() - loop_start;  // the time loop, output included
   history.flush(out);
+  write_escapes(out, solver.escapes(), solver.steps(), solver.time());
   out.write_end(status, message);
   out.close();
   if (status == kExitUnstable) {

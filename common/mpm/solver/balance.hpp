@@ -23,6 +23,8 @@ struct Balance {
   double external_work = 0;      ///< work of body forces, loads and rigid bodies since t = 0
   double removed = 0;            ///< kinetic + internal energy of particles removed at the domain
   Vec3 momentum = Vec3::Zero();  ///< kg m/s
+  double removed_mass = 0;       ///< kg, of the particles removed at the domain
+  Vec3 removed_momentum = Vec3::Zero();  ///< kg m/s, theirs when they left
   /// kinetic + internal + removed - external_work. The kinetic energy is taken at the half
   /// step and the internal energy at the full step, so this swings by O(dt) in impacts.
   double total() const { return kinetic + internal + removed - external_work; }
@@ -69,7 +71,8 @@ struct ChunkSums {
 };
 
 /// Particles that left the domain (indices in `exits`, possibly repeated) take their energy
-/// with them: it moves from kinetic and internal to `removed`. Sorts and de-duplicates
+/// with them: it moves from kinetic and internal to `removed`, and their mass and momentum
+/// to `removed_mass` and `removed_momentum`. Sorts and de-duplicates
 /// `exits` (the sort then drops them) and returns how many there are. Rigid particles carry
 /// no energy of the balance.
 template <int D>
@@ -85,6 +88,11 @@ std::size_t account_exits(ColumnStore& particles, std::vector<std::uint32_t>& ex
     balance.removed += ke + ie;
     balance.kinetic -= ke;
     balance.internal -= ie;
+    balance.removed_mass += p.m[i];
+    for (int a = 0; a < D; ++a) {
+      balance.removed_momentum[a] += p.m[i] * p.v[i][a];
+      balance.momentum[a] -= p.m[i] * p.v[i][a];
+    }
   }
   return exits.size();
 }

@@ -23,6 +23,7 @@
 #include "mpm/scene/particles.hpp"
 #include "mpm/scene/scene.hpp"
 #include "mpm/solver/balance.hpp"
+#include "mpm/solver/escapes.hpp"
 #include "mpm/solver/materials/material.hpp"
 
 namespace mpm {
@@ -132,6 +133,9 @@ class SolverCore {
   const Binning& binning() const { return binning_; }
   KernelTimers& timers() { return timers_; }
   std::size_t removed_particles() const { return removed_count_; }
+  /// The particles removed at the domain since the log was last cleared (by the run, once it
+  /// wrote them).
+  EscapeLog& escapes() { return escapes_; }
   const Scene& scene() const { return scene_; }
 
  protected:
@@ -188,6 +192,7 @@ class SolverCore {
   const std::uint8_t* material_ = nullptr;  ///< refreshed with every view
   std::vector<std::uint32_t> exits_;  ///< particles that left the domain, removed at next sort
   std::size_t removed_count_ = 0;
+  EscapeLog escapes_;  ///< what they were when they left
   Balance balance_;
   double total0_ = 0, energy_scale_ = 0;
   std::array<double, 6> face_force_{};
@@ -225,6 +230,7 @@ template <Grid GridT>
 void SolverCore<GridT>::sort_particles() {
   ScopedTimer timer(timers_, timers_.id("sort"));
   removed_count_ += account_exits<D>(particles_, exits_, balance_);
+  escapes_.add(particles_, exits_, time_);
   binning_.sort(particles_, grid_, exits_);
   exits_.clear();
   need_sort_ = false;

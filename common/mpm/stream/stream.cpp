@@ -113,6 +113,7 @@ bool known_type(std::uint32_t type) {
     case RecordType::Frame:
     case RecordType::History:
     case RecordType::Grid:
+    case RecordType::Escape:
     case RecordType::End:
       return true;
   }
@@ -264,6 +265,15 @@ void StreamWriter::write_record(RecordType type, const std::vector<std::byte>& p
 
 void StreamWriter::write_frame(const Frame& frame, const std::vector<std::string>& fields,
                                Precision precision) {
+  write_columns(RecordType::Frame, frame, fields, precision);
+}
+
+void StreamWriter::write_escapes(const Frame& escaped) {
+  write_columns(RecordType::Escape, escaped, {}, Precision::Float64);
+}
+
+void StreamWriter::write_columns(RecordType type, const Frame& frame,
+                                 const std::vector<std::string>& fields, Precision precision) {
   const ColumnStore& store = frame.columns;
   const std::size_t n = store.size();
   std::vector<OutColumn> out;
@@ -312,7 +322,7 @@ void StreamWriter::write_frame(const Frame& frame, const std::vector<std::string
     data_bytes += std::uint64_t(n) * info.components * scalar_size(o.type);
   }
 
-  begin_record(RecordType::Frame, head.b.size() + data_bytes);
+  begin_record(type, head.b.size() + data_bytes);
   put(head.b.data(), head.b.size());
   std::vector<float> buf;
   for (const OutColumn& o : out) {
@@ -514,7 +524,8 @@ void StreamReader::skip() {
 }
 
 Frame StreamReader::read_frame() {
-  if (!pending_ || type_ != std::uint32_t(RecordType::Frame))
+  if (!pending_ ||
+      (type_ != std::uint32_t(RecordType::Frame) && type_ != std::uint32_t(RecordType::Escape)))
     throw std::logic_error("StreamReader::read_frame: the current record is not a frame");
   if (length_ < kFrameFixedBytes) {
     fail_corrupt("a frame needs at least " + std::to_string(kFrameFixedBytes) + " bytes, it has " +
@@ -680,6 +691,12 @@ StreamSummary read_stream(const std::string& path, const StreamVisitor& visitor)
           else
             r.skip();
           break;
+        case RecordType::Escape:
+          if (visitor.escapes)
+            frame = r.read_frame();
+          else
+            r.skip();
+          break;
         default:
           r.skip();  // a record type of a later minor version
       }
@@ -704,6 +721,9 @@ StreamSummary read_stream(const std::string& path, const StreamVisitor& visitor)
         break;
       case RecordType::Grid:
         if (visitor.grid) visitor.grid(std::move(grid));
+        break;
+      case RecordType::Escape:
+        if (visitor.escapes) visitor.escapes(std::move(frame));
         break;
       case RecordType::End:
         s.ended = true;

@@ -16,7 +16,8 @@
 namespace mpm {
 
 inline constexpr std::uint16_t kStreamVersionMajor = 1;  ///< readers refuse other majors
-inline constexpr std::uint16_t kStreamVersionMinor = 1;  ///< readers accept any minor (1: GRID)
+/// Readers accept any minor (1: GRID; 2: ESCP).
+inline constexpr std::uint16_t kStreamVersionMinor = 2;
 
 /// Record types (little-endian fourcc).
 enum class RecordType : std::uint32_t {
@@ -26,6 +27,7 @@ enum class RecordType : std::uint32_t {
   History = 0x54534948,  ///< "HIST": rows of scalar time histories
   End = 0x53444E45,      ///< "ENDS": status and message; absent when the writer was killed
   Grid = 0x44495247,     ///< "GRID": a graded grid's nodes and cells (since 1.1; graded_grid.hpp)
+  Escape = 0x50435345,   ///< "ESCP": particles that left the domain, laid out as a frame (1.2)
 };
 /// "SCEN", "FRAM", ... for messages; "?xyz" style hex for unknown codes.
 std::string record_name(std::uint32_t type);
@@ -69,6 +71,9 @@ class StreamWriter {
   /// Float32 precision stores f64 columns as f32, except "x" (positions keep f64).
   void write_frame(const Frame& frame, const std::vector<std::string>& fields = {},
                    Precision precision = Precision::Float64);
+  /// Writes an ESCP record: the particles that left the domain, every column in f64 (the
+  /// layout of a frame; docs/format.md).
+  void write_escapes(const Frame& escaped);
   /// Writes a record of binary payload (GRID: encode_grid in grid_record.hpp).
   void write_record(RecordType type, const std::vector<std::byte>& payload);
   /// Writes a HIST record (names and units must have the same size, values a multiple of it).
@@ -84,6 +89,8 @@ class StreamWriter {
   const std::string& path() const { return path_; }
 
  private:
+  void write_columns(RecordType type, const Frame& frame, const std::vector<std::string>& fields,
+                     Precision precision);
   void begin_record(RecordType type, std::uint64_t length);
   void put(const void* data, std::size_t n);  ///< writes and updates the running CRC
   void end_record();
@@ -121,8 +128,8 @@ class StreamReader {
   bool next(std::uint32_t& type);
   /// The payload of the current record (checked against its CRC).
   std::vector<std::byte> read_payload();
-  /// The current record as a frame (must be a FRAM record), decoded straight into columns;
-  /// f32 columns are widened to f64. Checked against its CRC.
+  /// The current record as a frame (must be a FRAM or ESCP record), decoded straight into
+  /// columns; f32 columns are widened to f64. Checked against its CRC.
   Frame read_frame();
   /// Skips the current record (still checks its CRC), reading in chunks (works on pipes).
   void skip();
@@ -177,6 +184,8 @@ struct StreamVisitor {
   std::function<void(int, const std::string&)> end;
   /// GRID payloads (decode_grid in grid_record.hpp); skipped when empty.
   std::function<void(std::vector<std::byte>&&)> grid;
+  /// ESCP records: particles that left the domain, as a frame (since 1.2); skipped when empty.
+  std::function<void(Frame&&)> escapes;
   bool want_frames = true;  ///< false: frames are skipped without decoding
 };
 
