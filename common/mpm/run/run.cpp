@@ -191,8 +191,8 @@ class History {
   int dim_;
   double factor_;
   bool implicit_;
-  ImplicitWork last_;  ///< totals at the previous row
-  long last_step_ = -1;  ///< step of the last row
+  ImplicitWork last_;     ///< totals at the previous row
+  long last_step_ = -1;   ///< step of the last row
   bool removed_ = false;  ///< columns of what left the domain (solver.on_exit = "remove")
   std::vector<int> faces_, rigid_;
   HistoryBlock block_;
