@@ -64,14 +64,38 @@ void read_strength(Reader& r, StrengthSpec& s) {
   r.finish();
 }
 
+const std::initializer_list<std::string_view> kMieGruneisenKeys = {"c0", "s", "gamma0",
+                                                                   "energy_in_expansion"};
+const std::initializer_list<std::string_view> kTillotsonKeys = {
+    "a", "b", "A", "B", "E0", "E_iv", "E_cv", "alpha", "beta"};
+
+// Tillotson's constants, each required (docs/eos-tillotson.md derives lead's).
+void read_tillotson(Reader& r, TillotsonSpec& t) {
+  t.a = r.required("a", dim::none, Bound::NonNegative, "0.5");
+  t.b = r.required("b", dim::none, Bound::NonNegative, "1.63");
+  t.A = r.required("A", dim::pressure, Bound::Positive, "75.2 GPa");
+  t.B = r.required("B", dim::pressure, Bound::Any, "65 GPa");
+  t.E0 = r.required("E0", dim::specific_energy, Bound::Positive, "5 MJ/kg");
+  t.E_iv = r.required("E_iv", dim::specific_energy, Bound::NonNegative, "3 MJ/kg");
+  t.E_cv = r.required("E_cv", dim::specific_energy, Bound::Positive, "13.9 MJ/kg");
+  t.alpha = r.required("alpha", dim::none, Bound::NonNegative, "5");
+  t.beta = r.required("beta", dim::none, Bound::NonNegative, "5");
+  r.check("E_cv", t.E_cv > t.E_iv, "must be above E_iv (" + format_number(t.E_iv) + " J/kg)");
+}
+
 void read_eos(Reader& r, EosSpec& e) {
-  e.model = r.choice<EosModel>(
-                 "model", {{"linear", EosModel::Linear}, {"mie-gruneisen", EosModel::MieGruneisen}})
+  e.model = r.choice<EosModel>("model", {{"linear", EosModel::Linear},
+                                         {"mie-gruneisen", EosModel::MieGruneisen},
+                                         {"tillotson", EosModel::Tillotson}})
                 .value_or(EosModel::Linear);
   if (e.model == EosModel::Linear) {
-    r.reject({"c0", "s", "gamma0", "energy_in_expansion"},
-             "by the linear model (set model = \"mie-gruneisen\")");
+    r.reject(kMieGruneisenKeys, "by the linear model (set model = \"mie-gruneisen\")");
+    r.reject(kTillotsonKeys, "by the linear model (set model = \"tillotson\")");
+  } else if (e.model == EosModel::Tillotson) {
+    r.reject(kMieGruneisenKeys, "by the tillotson model (set model = \"mie-gruneisen\")");
+    read_tillotson(r, e.tillotson);
   } else {
+    r.reject(kTillotsonKeys, "by the mie-gruneisen model (set model = \"tillotson\")");
     e.c0 = r.required("c0", dim::velocity, Bound::Positive, "3940 m/s");
     e.s = r.required("s", dim::none, Bound::NonNegative, "1.49");
     e.gamma0 = r.required("gamma0", dim::none, Bound::NonNegative, "1.96");
@@ -104,7 +128,8 @@ MaterialSpec read_material(Reader& r, const std::string& name) {
                         "melt_temperature", "specific_heat", "taylor_quinney"})) {
     read_strength(*t, m.strength);
   }
-  if (auto t = r.table("eos", {"model", "c0", "s", "gamma0", "energy_in_expansion"}))
+  if (auto t = r.table("eos", {"model", "c0", "s", "gamma0", "energy_in_expansion", "a", "b", "A",
+                               "B", "E0", "E_iv", "E_cv", "alpha", "beta"}))
     read_eos(*t, m.eos);
   if (auto t = r.table("failure", {"plastic_strain", "pressure"})) read_failure(*t, m.failure);
   r.finish();
