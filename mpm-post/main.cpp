@@ -158,6 +158,11 @@ CLI::App* add_profile(CLI::App& app, mpm::ProfileArgs& a) {
   sub->add_option("--body", a.body, "only this body's particles");
   sub->add_option("--bins", a.profile.bins,
                   "average in this many equal bins along the line (default: one row per particle)");
+  sub->add_option("--weight", a.weight,
+                  "what a particle weighs in a bin's mean (and the weight column): volume "
+                  "(m/rho: a mean over space) or mass (m: a mean over material); --grid: mass")
+      ->check(CLI::IsMember({"volume", "mass"}))
+      ->capture_default_str();
   sub->add_flag("--grid", a.grid,
                 "on the grid: project the field onto the run's grid nodes (linear shape "
                 "functions, mass-weighted) and profile the nodes near the line");

@@ -98,6 +98,7 @@ struct ProfileArgs {
   ProfileOptions profile;          ///< field and bins as given; the rest is set from the above
   bool json = false;               ///< print JSON (SI units)
   bool grid = false;               ///< profile the field projected onto the run's grid nodes
+  std::string weight = "volume";   ///< bins' means weighted by particle "volume" or "mass"
 };
 int post_profile(const ProfileArgs& args);
 

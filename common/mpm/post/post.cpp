@@ -223,8 +223,8 @@ std::vector<std::size_t> fragment_sizes(const std::vector<Vec3>& points, double 
 
 DebrisMeter::DebrisMeter(const Scene& scene, const Frame& first, const DebrisOptions& options)
     : opt_(options), symmetry_(options.symmetry.value_or(scene_symmetry(scene))) {
-  const Impact im = find_impact(scene, first, symmetry_,
-                                {opt_.axis, opt_.projectile, opt_.target}, "debris");
+  const Impact im =
+      find_impact(scene, first, symmetry_, {opt_.axis, opt_.projectile, opt_.target}, "debris");
   dim_ = im.dimension;
   axisymmetric_ = scene.axisymmetric;
   axis_ = im.axis;
