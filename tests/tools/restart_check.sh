@@ -30,8 +30,10 @@ start=$(date +%s.%N)
 run "$work/model.mpm" "$work/full.mpm"
 full_s=$(echo "$(date +%s.%N) - $start" | bc)
 
-# The run to kill: SIGKILL half a second after its first checkpoint reached the file.
-run "$work/model.mpm" "$work/killed.mpm" &
+# The run to kill: SIGKILL half a second after its first checkpoint reached the file. Started
+# as a plain command (not through the function), so that $! is mpm-run itself.
+"$runner" "$work/model.mpm" --threads "$threads" --progress none -o "$work/killed.mpm" \
+  2>"$work/killed_err.txt" &
 pid=$!
 while [ "$(grep -a -o CHKP "$work/killed.mpm" 2>/dev/null | wc -l)" -lt 1 ]; do
   kill -0 $pid 2>/dev/null || { echo "the run ended before its first checkpoint" >&2; exit 1; }
@@ -40,6 +42,7 @@ done
 sleep 0.5
 kill -KILL $pid
 wait $pid && { echo "the run completed before the kill" >&2; exit 1; } || status=$?
+pgrep -f -- "-o $work/killed.mpm" >/dev/null && { echo "the killed run is still alive" >&2; exit 1; }
 killed_bytes=$(stat -c %s "$work/killed.mpm")
 start=$(date +%s.%N)
 "$runner" --restart "$work/killed.mpm" --threads "$threads" --progress none 2>"$work/restart.txt"
