@@ -282,15 +282,18 @@ DebrisMeter::DebrisMeter(const Scene& scene, const Frame& first, const DebrisOpt
       if (std::abs(vp[a]) > std::abs(vp[axis_])) axis_ = a;
   }
   direction_ = vp[axis_] < 0 ? -1 : 1;
-  // The projectile's initial centre, and the target's rear face (surface).
-  double far = -1e300;
+  // The projectile's initial centre, and the target's rear and impact faces (surface).
+  double far = -1e300, near = 1e300;
   std::size_t np = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (body[i] == proj) {
       for (int a = 0; a < dim_; ++a) point_[a] += x[i * dim_ + a];
       ++np;
     }
-    if (body[i] == target) far = std::max(far, direction_ * x[i * dim_ + axis_]);
+    if (body[i] == target) {
+      far = std::max(far, direction_ * x[i * dim_ + axis_]);
+      near = std::min(near, direction_ * x[i * dim_ + axis_]);
+    }
   }
   if (np == 0 || far < -1e299)
     throw InputError("debris", "the first frame lacks the projectile or the target");
@@ -298,6 +301,7 @@ DebrisMeter::DebrisMeter(const Scene& scene, const Frame& first, const DebrisOpt
   if (axisymmetric_) point_.x() = 0;  // the axis of revolution, whatever the projectile's rings
   const double spacing = scene.bodies[target].spacing(scene.grid.cell_size);
   plane_ = opt_.plane ? *opt_.plane : direction_ * (far + 0.5 * spacing);
+  face_plane_ = opt_.face == DebrisFace::Impact ? direction_ * (near - 0.5 * spacing) : plane_;
   link_ = opt_.link > 0 ? opt_.link : scene.grid.cell_size;
   if (opt_.min_fragment < 1) throw InputError("--min-fragment", "expected at least 1 particle");
   (void)v;
@@ -311,6 +315,8 @@ DebrisResult DebrisMeter::measure(const Frame& frame) const {
   r.axis = axis_;
   r.direction = direction_;
   r.plane = plane_;
+  r.face = opt_.face;
+  r.face_plane = face_plane_;
   r.axis_point = point_;
   r.total = n;
   r.percentile = opt_.percentile;
@@ -332,7 +338,7 @@ DebrisResult DebrisMeter::measure(const Frame& frame) const {
       p[a] = x[i * dim_ + a];
       if (a != axis_) r2 += (x[i * dim_ + a] - point_[a]) * (x[i * dim_ + a] - point_[a]);
     }
-    front.push_back(d);
+    front.push_back(direction_ * (x[i * dim_ + axis_] - face_plane_));
     width.push_back(2 * std::sqrt(r2));
     cloud.push_back(p);
   }
