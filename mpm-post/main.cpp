@@ -67,6 +67,10 @@ CLI::App* add_taylor(CLI::App& app, mpm::TaylorArgs& a) {
   sub->add_option("--expect-L", a.expect_L,
                   "reference length, e.g. \"16.2 mm\", to print the difference");
   sub->add_option("--expect-D", a.expect_D, "reference diameter, e.g. \"13.5 mm\"");
+  sub->add_option("--symmetry", a.symmetry,
+                  "mirror planes of a quarter or half model, e.g. \"x = 0, y = 0 mm\", or "
+                  "\"none\"; the measure is the whole body's (default: the scene's slip faces "
+                  "through a body)");
   sub->add_flag("--json", a.json, "print JSON (SI units)");
   return sub;
 }
@@ -104,6 +108,30 @@ CLI::App* add_debris(CLI::App& app, mpm::DebrisArgs& a) {
                   "linking length of fragments, e.g. \"1 mm\" (default: the grid's cell size)");
   sub->add_option("--expect-front", a.expect_front, "reference front, e.g. \"200 mm\"");
   sub->add_option("--expect-width", a.expect_width, "reference width, e.g. \"145 mm\"");
+  sub->add_option("--symmetry", a.symmetry,
+                  "mirror planes of a quarter or half model, e.g. \"x = 0, y = 0 mm\", or "
+                  "\"none\"; the measure is the whole body's (default: the scene's slip faces "
+                  "through a body)");
+  sub->add_flag("--json", a.json, "print JSON (SI units)");
+  return sub;
+}
+
+CLI::App* add_crater(CLI::App& app, mpm::CraterArgs& a) {
+  auto* sub = app.add_subcommand(
+      "crater",
+      "depth and diameter of a target's crater (or the hole when perforated) on the impact "
+      "axis, and how deep each body went");
+  sub->add_option("input", a.input, "stream, - for stdin")->capture_default_str();
+  sub->add_option("--time", a.time,
+                  "the frame nearest this time, e.g. \"40 us\" (default: the last)");
+  sub->add_option("--target", a.target, "target body (default: the first body at rest)");
+  sub->add_option("--projectile", a.projectile,
+                  "projectile body: the crater's axis runs through its initial centre (default: "
+                  "the fastest body)");
+  sub->add_option("--axis", a.axis, "impact axis x, y or z (default: the projectile's velocity)");
+  sub->add_option("--symmetry", a.symmetry,
+                  "mirror planes of a quarter or half model, e.g. \"x = 0, y = 0 mm\", or "
+                  "\"none\" (default: the scene's slip faces through a body)");
   sub->add_flag("--json", a.json, "print JSON (SI units)");
   return sub;
 }
@@ -154,11 +182,23 @@ CLI::App* add_render(CLI::App& app, mpm::RenderArgs& a) {
       ->capture_default_str();
   sub->add_option("--component", a.picture.component,
                   "component of a vector field (-1: magnitude)");
-  sub->add_option("--view", a.picture.view, "side, front, top or iso")
-      ->check(CLI::IsMember({"side", "front", "top", "iso"}))
+  sub->add_option("--view", a.picture.view,
+                  "orthographic view: side (looking along -y), front (-x), top (-z), iso (from "
+                  "+x+y+z), or symmetry (square on to a mirror plane of a quarter or half model: "
+                  "the section of the whole body there, e.g. through a crater)")
+      ->check(CLI::IsMember({"side", "front", "top", "iso", "symmetry"}))
       ->capture_default_str();
+  sub->add_option("--section", a.picture.section,
+                  "cut at a plane in absolute coordinates, e.g. \"x = 0\" or \"y = 2.5 mm\" "
+                  "(plain numbers in m): keeps the side with more particles and looks square at "
+                  "the cut");
+  sub->add_option("--symmetry", a.symmetry,
+                  "mirror planes of a quarter or half model, e.g. \"x = 0, y = 0 mm\", or "
+                  "\"none\"; the picture shows the whole body (default: the scene's slip faces "
+                  "through a body)");
   sub->add_option("--clip", a.picture.clip,
-                  "keep one side of a plane through the centroid, e.g. \"y>0\"");
+                  "keep one side of a plane given as an OFFSET FROM THE MODEL'S CENTROID, e.g. "
+                  "\"y>0\" (the centroid's side), \"y>2mm\"; for absolute planes use --section");
   sub->add_option("--size", a.size, "WIDTHxHEIGHT in pixels")->capture_default_str();
   sub->add_option("--range", a.range, "colour range MIN:MAX (SI units)");
   sub->add_option("--title", a.picture.title, "title text");
@@ -189,6 +229,7 @@ int main(int argc, char** argv) {
   mpm::TaylorArgs taylor_args;
   mpm::DebrisArgs debris_args;
   mpm::ProfileArgs profile_args;
+  mpm::CraterArgs crater_args;
   mpm::RenderArgs render_args;
   const auto* summary = add_summary(app, summary_args);
   const auto* history = add_history(app, history_args);
@@ -197,6 +238,7 @@ int main(int argc, char** argv) {
   const auto* taylor = add_taylor(app, taylor_args);
   const auto* debris = add_debris(app, debris_args);
   const auto* profile = add_profile(app, profile_args);
+  const auto* crater = add_crater(app, crater_args);
   const auto* render = add_render(app, render_args);
   try {
     app.parse(argc, argv);
@@ -218,6 +260,7 @@ int main(int argc, char** argv) {
     if (*taylor) return mpm::post_taylor(taylor_args);
     if (*debris) return mpm::post_debris(debris_args);
     if (*profile) return mpm::post_profile(profile_args);
+    if (*crater) return mpm::post_crater(crater_args);
     if (*render) {
       mpm::ensure_display(argc, argv);  // before reading: a re-run under xvfb reads stdin again
       return mpm::post_render(render_args);

@@ -12,7 +12,8 @@ int main(int argc, char** argv) {
       "mpm-run: explicit material point method solver.\n"
       "Reads a model stream (from mpm-prep) and writes a result stream of frames and\n"
       "histories (for mpm-post). Exit status: 0 done, 2 bad input, 3 unstable run,\n"
-      "4 write failure, 128+N killed by signal N.",
+      "4 write failure, 128+N stopped by signal N (SIGINT, SIGTERM: after a checkpoint;\n"
+      "continue with --restart RESULT).",
       "mpm-run"};
   mpm::RunOptions opt;
   std::string progress = "auto";
@@ -35,6 +36,10 @@ int main(int argc, char** argv) {
   app.add_option("--progress", progress, "progress on stderr: auto, bar, lines or none")
       ->check(CLI::IsMember({"auto", "bar", "lines", "none"}))
       ->capture_default_str();
+  app.add_option("--restart", opt.restart,
+                 "continue the result stream RESULT from its last intact checkpoint (a run "
+                 "killed, cut or stopped by a signal); appends to RESULT, or writes -o")
+      ->type_name("RESULT");
   app.set_version_flag("--version", std::string("mpm-run ") + mpm::kVersion);
   try {
     app.parse(argc, argv);
@@ -48,6 +53,11 @@ int main(int argc, char** argv) {
                                        : mpm::ProgressMode::Auto;
   return mpm::guarded_main("mpm-run", [&] {
     mpm::ignore_sigpipe();
+    if (!opt.restart.empty()) {
+      if (app.count("input"))
+        throw mpm::InputError("--restart", "continues a result stream; give no model stream");
+      if (!app.count("--output")) opt.output = opt.restart;  // append to it
+    }
     mpm::refuse_terminal_output(opt.output, "the result stream");
     mpm::check_output_file(opt.output, {opt.input});
     return mpm::run_model(opt);

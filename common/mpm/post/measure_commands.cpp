@@ -9,6 +9,7 @@
 #include "mpm/post/commands.hpp"
 #include "mpm/post/json.hpp"
 #include "mpm/post/post.hpp"
+#include "mpm/post/symmetry.hpp"
 
 namespace mpm {
 
@@ -28,6 +29,8 @@ void print_taylor_json(const TaylorResult& r, std::optional<double> eL, std::opt
   j.key("spacing").number(r.spacing).key("particles").integer(r.particles);
   j.key("D_min").number(r.D_min).key("D_max").number(r.D_max);
   j.key("D_radius").number(r.D_radius);
+  j.key("symmetry");
+  write_symmetry_json(j, r.symmetry);
   if (eL) j.key("expected_L").number(*eL).key("error_L").number(r.L / *eL - 1);
   if (eD) j.key("expected_D").number(*eD).key("error_D").number(r.D / *eD - 1);
   j.end_object();
@@ -39,6 +42,7 @@ void print_taylor_text(const TaylorResult& r, std::optional<double> eL, std::opt
               r.time * 1e6,
               r.measure == "centres" ? "particle centres" : "surface: centres + half a spacing",
               "xyz"[r.axis], r.wall * 1e3, r.particles);
+  if (!r.symmetry.describe().empty()) std::printf("  %s\n", r.symmetry.describe().c_str());
   std::printf("  L = %.3f mm", r.L * 1e3);
   if (eL) std::printf("   expected %.3f mm, %+.2f%%", *eL * 1e3, 100 * (r.L / *eL - 1));
   std::printf("   (L0 = %.3f mm, L/L0 = %.4f)\n", r.L0 * 1e3, r.L / r.L0);
@@ -69,6 +73,8 @@ void print_debris_json(const DebrisResult& r, std::optional<double> ef, std::opt
   j.key("fragments").integer(r.fragments).key("single_particle_fragments").integer(r.singles);
   j.key("largest_fragment").integer(r.largest).key("counted_particles").integer(r.counted);
   j.key("percentiles_of").string(r.by_mass ? "mass" : "particles");
+  j.key("symmetry");
+  write_symmetry_json(j, r.symmetry);
   if (ef) j.key("expected_front").number(*ef).key("error_front").number(r.front / *ef - 1);
   if (ew) j.key("expected_width").number(*ew).key("error_width").number(r.width / *ew - 1);
   j.end_object();
@@ -81,6 +87,7 @@ void print_debris_text(const DebrisResult& r, std::optional<double> ef, std::opt
       "(the target's rear face), impact along %s%c\n",
       r.time * 1e6, r.cloud, r.total, "xyz"[r.axis], r.plane * 1e3, r.direction > 0 ? "+" : "-",
       "xyz"[r.axis]);
+  if (!r.symmetry.describe().empty()) std::printf("  %s\n", r.symmetry.describe().c_str());
   if (r.face == DebrisFace::Impact)
     std::printf("  front measured from the target's impact face %c = %.3f mm\n", "xyz"[r.axis],
                 r.face_plane * 1e3);
@@ -118,7 +125,11 @@ int post_taylor(const TaylorArgs& a) {
   if (!a.axis.empty()) opt.axis = option_axis(a.axis, "--axis");
   if (!a.wall.empty()) opt.wall = option_quantity(a.wall, dim::length, "--wall");
   StreamVisitor v;
-  v.scene = [&](const std::string& t) { meter.emplace(scene_of(t, path), opt); };
+  v.scene = [&](const std::string& t) {
+    const Scene scene = scene_of(t, path);
+    opt.symmetry = measure_symmetry(a.symmetry, scene);
+    meter.emplace(scene, opt);
+  };
   v.frame = [&](Frame&& f) {
     ++frames;
     if (!meter) throw StreamError(input_name(path), "a frame comes before the scene record");
@@ -164,7 +175,10 @@ int post_debris(const DebrisArgs& a) {
   double best = 1e300;
   std::size_t frames = 0;
   StreamVisitor v;
-  v.scene = [&](const std::string& t) { scene = scene_of(t, path); };
+  v.scene = [&](const std::string& t) {
+    scene = scene_of(t, path);
+    opt.symmetry = measure_symmetry(a.symmetry, *scene);
+  };
   v.frame = [&](Frame&& f) {
     ++frames;
     if (!scene) throw StreamError(input_name(path), "a frame comes before the scene record");

@@ -14,6 +14,7 @@
 #include "mpm/grid/lattice.hpp"
 #include "mpm/grid/sparse_grid.hpp"
 #include "mpm/prep/graded_voxelise.hpp"
+#include "mpm/prep/initial_fields.hpp"
 #include "mpm/prep/region.hpp"
 #include "mpm/prep/voxelise.hpp"
 #include "mpm/scene/particles.hpp"
@@ -256,6 +257,7 @@ int prepare_model(const PrepOptions& opt) {
   std::optional<GradedModel> graded;  // scenes with grid levels (004, section 3.2)
   if (!scene.grid.levels.empty()) graded = prepare_graded(scene, lattice, report);
   ColumnStore cols = graded ? std::move(graded->columns) : voxelise(scene, lattice, report);
+  apply_initial_fields(scene, cols);  // spin, velocity and stress fields
   const GradedModel* graded_grid = graded ? &*graded : nullptr;
   const std::string text = with_explicit_domain(scene.toml, lattice);
   const Estimates estimates = estimate_run(scene, lattice, cols, graded_grid);

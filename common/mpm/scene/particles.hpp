@@ -37,6 +37,12 @@ inline const std::string thickness =
 /// Material id of the particles of rigid bodies (they have no material).
 inline constexpr std::uint8_t kRigidMaterial = 255;
 
+/// The body of element i of a body column: u8, or u32 in models of more than 255 bodies.
+inline std::uint32_t body_id(const Column& body, std::size_t i) {
+  return body.info().type == ScalarType::U8 ? std::uint32_t(body.as<std::uint8_t>()[i])
+                                            : body.as<std::uint32_t>()[i];
+}
+
 /// Raw pointers into the particle columns for the kernels; optional columns are nullptr when
 /// absent. Valid until the columns are resized or reordered.
 template <int D>

@@ -85,6 +85,17 @@ struct MaterialSpec {
 
 enum class ShapeKind { Box, Cylinder, Sphere, Mesh };
 
+/// A formula of position written in the scene (a body's velocity_field or stress_field), SI.
+/// Its variables are field_variables(); "0" stands for an absent component.
+struct FieldExpression {
+  std::string text;
+  SourceLoc loc;  ///< the key, e.g. "bodies.bar.velocity_field[0]"
+};
+/// The variables of field expressions, in the order prep binds them: x, y, z (m; z = 0 in 2D),
+/// r (m, the distance from the centre of the body's bounding box), and that box, x_min, x_max,
+/// y_min, y_max, z_min, z_max (m).
+const std::vector<std::string>& field_variables();
+
 /// A body: a shape in its local frame, placed by scale, then rotation, then translation.
 /// Local frames: box centred on the origin; cylinder along +z from z = 0 to z = length,
 /// axis through the origin; sphere centred on the origin; mesh as in its file.
@@ -109,6 +120,16 @@ struct BodySpec {
   /// The body's particle spacing on cells of size h.
   double spacing(double h) const {
     return particle_spacing > 0 ? particle_spacing : h / particles_per_cell;
+  }
+  /// Initial spin and fields (docs/scene.md, initial fields): the particle at x starts at
+  /// velocity + angular_velocity x (x - spin_centre) + velocity_field(x), stress stress_field(x).
+  Vec3 angular_velocity = Vec3::Zero();         ///< rad/s (2D: z only)
+  bool spin_centre_given = false;               ///< else the centre of the body's bounding box
+  Vec3 spin_centre = Vec3::Zero();              ///< m
+  std::vector<FieldExpression> velocity_field;  ///< one per axis, m/s; empty: none
+  std::vector<FieldExpression> stress_field;    ///< xx yy zz yz xz xy (Voigt), Pa; empty: none
+  bool has_initial_fields() const {
+    return !angular_velocity.isZero(0) || !velocity_field.empty() || !stress_field.empty();
   }
   bool rigid = false;  ///< moves at `velocity` whatever happens
   /// Rigid bodies: bit a set = the contact is frictionless along axis a (the nodes the body
@@ -235,6 +256,8 @@ struct OutputSpec {
   double history_interval = 0;      ///< s; 0: every step
   std::vector<std::string> fields;  ///< particle columns written in frames; empty: all
   Precision precision = Precision::Float64;
+  double checkpoint_time = 0;  ///< s of simulated time between checkpoints; 0: none
+  double checkpoint_wall = 0;  ///< s of wall-clock time between checkpoints; 0: none
 };
 
 struct Scene {

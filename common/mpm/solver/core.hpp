@@ -17,6 +17,7 @@
 
 #include "mpm/core/columns.hpp"
 #include "mpm/core/error.hpp"
+#include "mpm/core/state_values.hpp"
 #include "mpm/core/timers.hpp"
 #include "mpm/grid/binning.hpp"
 #include "mpm/grid/grid.hpp"
@@ -134,6 +135,20 @@ class SolverCore {
   std::size_t removed_particles() const { return removed_count_; }
   const Scene& scene() const { return scene_; }
 
+  /// True when the next step begins by re-sorting the particles (some left their cell's bin,
+  /// the grid window or the domain).
+  bool sort_pending() const { return need_sort_; }
+  /// Sorts the particles into cell order now: the sort the next step would begin with when
+  /// sort_pending() (the results stay bitwise the same), else an extra one (they change at
+  /// round-off). After it the particle columns determine the bins and the grid window, so the
+  /// columns and save_state() are the whole state: a checkpoint.
+  void settle() { sort_particles(); }
+  /// Writes the state between steps that the particle columns do not hold: the clock, the
+  /// balance, the energy guard's reference, the counters.
+  void save_state(StateValues& s) const;
+  /// Restores what save_state() wrote, on a solver built from the columns saved with it.
+  void restore_state(const StateValues& s);
+
  protected:
   /// Takes the particles (columns as written by mpm-prep; state columns are added) and a grid
   /// built for the scene; checks that they start in the domain. The columns stay the caller's.
@@ -229,6 +244,38 @@ void SolverCore<GridT>::sort_particles() {
   exits_.clear();
   need_sort_ = false;
   material_ = view<D>(particles_).material;
+}
+
+template <Grid GridT>
+void SolverCore<GridT>::save_state(StateValues& s) const {
+  s.set("step", double(steps_));
+  s.set("time", time_);
+  s.set("particle_steps", particle_steps_);
+  s.set("removed_particles", double(removed_count_));
+  s.set("kinetic", balance_.kinetic);
+  s.set("internal", balance_.internal);
+  s.set("external_work", balance_.external_work);
+  s.set("removed", balance_.removed);
+  for (int a = 0; a < 3; ++a) s.set(std::string("momentum_") + "xyz"[a], balance_.momentum[a]);
+  s.set("leapfrog_total", balance_.leapfrog_total);
+  s.set("total0", total0_);
+  s.set("energy_scale", energy_scale_);
+}
+
+template <Grid GridT>
+void SolverCore<GridT>::restore_state(const StateValues& s) {
+  steps_ = long(s.get("step"));
+  time_ = s.get("time");
+  particle_steps_ = s.get("particle_steps");
+  removed_count_ = std::size_t(s.get("removed_particles"));
+  balance_.kinetic = s.get("kinetic");
+  balance_.internal = s.get("internal");
+  balance_.external_work = s.get("external_work");
+  balance_.removed = s.get("removed");
+  for (int a = 0; a < 3; ++a) balance_.momentum[a] = s.get(std::string("momentum_") + "xyz"[a]);
+  balance_.leapfrog_total = s.get("leapfrog_total");
+  total0_ = s.get("total0");
+  energy_scale_ = s.get("energy_scale");
 }
 
 template <Grid GridT>

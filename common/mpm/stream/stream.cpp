@@ -113,6 +113,7 @@ bool known_type(std::uint32_t type) {
     case RecordType::Frame:
     case RecordType::History:
     case RecordType::Grid:
+    case RecordType::Checkpoint:
     case RecordType::End:
       return true;
   }
@@ -264,6 +265,11 @@ void StreamWriter::write_record(RecordType type, const std::vector<std::byte>& p
 
 void StreamWriter::write_frame(const Frame& frame, const std::vector<std::string>& fields,
                                Precision precision) {
+  write_columns(RecordType::Frame, {}, frame, fields, precision);
+}
+
+void StreamWriter::write_columns(RecordType type, const std::string& prefix, const Frame& frame,
+                                 const std::vector<std::string>& fields, Precision precision) {
   const ColumnStore& store = frame.columns;
   const std::size_t n = store.size();
   std::vector<OutColumn> out;
@@ -312,7 +318,8 @@ void StreamWriter::write_frame(const Frame& frame, const std::vector<std::string
     data_bytes += std::uint64_t(n) * info.components * scalar_size(o.type);
   }
 
-  begin_record(RecordType::Frame, head.b.size() + data_bytes);
+  begin_record(type, prefix.size() + head.b.size() + data_bytes);
+  put(prefix.data(), prefix.size());
   put(head.b.data(), head.b.size());
   std::vector<float> buf;
   for (const OutColumn& o : out) {
@@ -516,9 +523,13 @@ void StreamReader::skip() {
 Frame StreamReader::read_frame() {
   if (!pending_ || type_ != std::uint32_t(RecordType::Frame))
     throw std::logic_error("StreamReader::read_frame: the current record is not a frame");
-  if (length_ < kFrameFixedBytes) {
+  return read_frame_body();
+}
+
+Frame StreamReader::read_frame_body() {
+  if (length_ - done_ < kFrameFixedBytes) {
     fail_corrupt("a frame needs at least " + std::to_string(kFrameFixedBytes) + " bytes, it has " +
-                 std::to_string(length_));
+                 std::to_string(length_ - done_));
   }
   Frame frame;
   auto get = [&](auto& v) { read_exact(&v, sizeof v); };
@@ -711,6 +722,8 @@ StreamSummary read_stream(const std::string& path, const StreamVisitor& visitor)
         s.end_message = end.second;
         if (visitor.end) visitor.end(end.first, end.second);
         return s;  // ENDS is the last record; anything after it is ignored
+      case RecordType::Checkpoint:
+        break;  // read by mpm-run --restart only (restart.hpp)
     }
   }
   return s;

@@ -38,6 +38,10 @@ class ExplicitSolver : public SolverCore<GridT> {
   /// Particles split into 2^D children so far (graded grids, 004 section 3.3).
   long splits() const { return split_count_; }
   ScatterStrategy strategy() const { return scatter_.strategy(); }
+  /// The state between steps beyond the particle columns (SolverCore's, the stable step and
+  /// the split counters); restore on a solver built from the columns saved with it.
+  void save_state(StateValues& s) const;
+  void restore_state(const StateValues& s);
   /// Bytes held by the solver beyond the particle columns: grid window, private scatter
   /// arrays, sort scratch and bins.
   std::size_t work_bytes() const;

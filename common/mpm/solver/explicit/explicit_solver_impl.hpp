@@ -74,6 +74,26 @@ template <Grid GridT>
 ExplicitSolver<GridT>::~ExplicitSolver() = default;
 
 template <Grid GridT>
+void ExplicitSolver<GridT>::save_state(StateValues& s) const {
+  Core::save_state(s);
+  s.set("stable_dt", stable_dt_);
+  s.set("leapfrog_kinetic", leapfrog_kinetic_);
+  s.set("next_id", double(next_id_));
+  s.set("splits", double(split_count_));
+  s.set("split_wait", double(split_wait_));
+}
+
+template <Grid GridT>
+void ExplicitSolver<GridT>::restore_state(const StateValues& s) {
+  Core::restore_state(s);
+  stable_dt_ = s.get("stable_dt");
+  leapfrog_kinetic_ = s.get("leapfrog_kinetic");
+  next_id_ = std::uint32_t(s.get("next_id"));
+  split_count_ = long(s.get("splits"));
+  split_wait_ = int(s.get("split_wait"));
+}
+
+template <Grid GridT>
 std::size_t ExplicitSolver<GridT>::work_bytes() const {
   std::size_t b = grid_.nodes() * (sizeof(double) + 3 * sizeof(Vec<D>) + (has_rigid_ ? 1 : 0));
   b += scatter_.bytes();
