@@ -41,8 +41,11 @@ def vaporised(post, path, d):
 
 
 def row(build, variant):
+    """The markdown row of a finished run; None when its log shows no finished run."""
     post = f"{build}/mpm-post/mpm-post"
     path = f"out/{variant}.mpm"
+    if "(time loop)" not in open(f"out/run_{variant}.log").read():
+        return None
     rear, impact = debris(post, path, "rear"), debris(post, path, "impact")
     iv, cv = vaporised(post, path, rear)
     run = open(f"out/run_{variant}.log").read()
@@ -65,4 +68,5 @@ if __name__ == "__main__":
           "| cloud mass past E_iv / E_cv | p99.5 rear vs 200 mm |")
     print("|---|---|---|---|---|---|---|---|---|")
     for v in sys.argv[2:]:
-        print(row(sys.argv[1], v), flush=True)
+        r = row(sys.argv[1], v)
+        print(r if r else f"| {v} | (not finished: out/run_{v}.log) |", flush=True)
