@@ -85,6 +85,11 @@ CLI::App* add_debris(CLI::App& app, mpm::DebrisArgs& a) {
   sub->add_option(
       "--plane", a.plane,
       "reference plane along the axis, e.g. \"6.36 mm\" (default: the target's rear face)");
+  sub->add_option("--face", a.face,
+                  "the target's face the front is measured from: rear or impact (the cloud is "
+                  "what lies behind the rear face either way)")
+      ->check(CLI::IsMember({"rear", "impact"}))
+      ->capture_default_str();
   sub->add_option("--target", a.target, "target body (default: the first body at rest)");
   sub->add_option("--projectile", a.projectile, "projectile body (default: the fastest body)");
   sub->add_option(

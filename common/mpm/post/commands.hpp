@@ -58,6 +58,7 @@ struct DebrisArgs {
   std::string time;              ///< the frame nearest this time; empty: the last
   std::string axis;              ///< impact axis "x", "y" or "z"; empty: the projectile's velocity
   std::string plane;             ///< reference plane (length); empty: the target's rear face
+  std::string face = "rear";     ///< the face the front is measured from: "rear" or "impact"
   std::string target;            ///< target body; empty: the first body at rest
   std::string projectile;        ///< projectile body; empty: the fastest body
   std::string expect_front;      ///< reference front (length); empty: none

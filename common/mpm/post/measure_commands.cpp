@@ -87,6 +87,8 @@ void print_debris_json(const DebrisResult& r, std::optional<double> ef, std::opt
   JsonWriter j;
   j.begin_object().key("time").number(r.time).key("axis").string(std::string(1, "xyz"[r.axis]));
   j.key("direction").integer(r.direction).key("plane").number(r.plane);
+  j.key("face").string(r.face == DebrisFace::Impact ? "impact" : "rear");
+  j.key("face_plane").number(r.face_plane);
   j.key("cloud_particles").integer(r.cloud).key("particles").integer(r.total);
   j.key("percentile").number(r.percentile).key("front").number(r.front);
   j.key("width").number(r.width).key("front_max").number(r.front_max);
@@ -118,6 +120,9 @@ void print_debris_text(const DebrisResult& r, std::optional<double> ef, std::opt
       r.time * 1e6, r.cloud, r.total, "xyz"[r.axis], r.plane * 1e3, r.direction > 0 ? "+" : "-",
       "xyz"[r.axis]);
   if (!r.symmetry.describe().empty()) std::printf("  %s\n", r.symmetry.describe().c_str());
+  if (r.face == DebrisFace::Impact)
+    std::printf("  front measured from the target's impact face %c = %.3f mm\n", "xyz"[r.axis],
+                r.face_plane * 1e3);
   std::printf(
       "  fragments (particles closer than %.3g mm linked): %zu, %zu of them single particles, "
       "the "
@@ -193,6 +198,7 @@ int post_debris(const DebrisArgs& a) {
   if (!a.link.empty()) opt.link = option_quantity(a.link, dim::length, "--link");
   if (!a.axis.empty()) opt.axis = option_axis(a.axis, "--axis");
   if (!a.plane.empty()) opt.plane = option_quantity(a.plane, dim::length, "--plane");
+  opt.face = a.face == "impact" ? DebrisFace::Impact : DebrisFace::Rear;
   std::optional<double> at;
   if (!a.time.empty()) at = option_quantity(a.time, dim::time, "--time");
   std::optional<Scene> scene;
