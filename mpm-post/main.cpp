@@ -9,6 +9,7 @@
 #include "mpm/core/cli.hpp"
 #include "mpm/core/error.hpp"
 #include "mpm/core/version.hpp"
+#include "mpm/post/command_io.hpp"
 #include "mpm/post/commands.hpp"
 #include "mpm/post/vtk/vtk_commands.hpp"
 
@@ -261,6 +262,12 @@ int main(int argc, char** argv) {
     if (*particles) mpm::check_output_file(particles_args.output, {particles_args.input});
     if (*profile) mpm::check_output_file(profile_args.output, {profile_args.input});
     if (*render) mpm::check_output_file(render_args.output, {render_args.input});
+    // Measures need a result: a model from mpm-prep is refused, naming what to run.
+    if (*history) mpm::require_result(history_args.input, "history");
+    if (*taylor) mpm::require_result(taylor_args.input, "taylor");
+    if (*debris) mpm::require_result(debris_args.input, "debris");
+    if (*profile) mpm::require_result(profile_args.input, "profile");
+    if (*render) mpm::require_result(render_args.input, "render");
     if (*summary) return mpm::post_summary(summary_args);
     if (*history) return mpm::post_history(history_args);
     if (*particles) return mpm::post_particles(particles_args);

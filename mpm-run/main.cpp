@@ -1,6 +1,7 @@
 // mpm-run: the solver. Reads a model stream (from mpm-prep), writes a result stream.
 //   mpm-prep scene.toml | mpm-run --threads 2 --stats | mpm-post taylor -
 #include <CLI/CLI.hpp>
+#include <cstdio>
 
 #include "mpm/core/cli.hpp"
 #include "mpm/core/error.hpp"
@@ -40,11 +41,21 @@ int main(int argc, char** argv) {
                  "continue the result stream RESULT from its last intact checkpoint (a run "
                  "killed, cut or stopped by a signal); appends to RESULT, or writes -o")
       ->type_name("RESULT");
+  std::string max_memory;
+  app.add_option("--max-memory", max_memory,
+                 "refuse a model whose run would need more memory (e.g. 16G; K, M, G, T are "
+                 "powers of 1024); default: the machine's memory");
   app.set_version_flag("--version", std::string("mpm-run ") + mpm::kVersion);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
+    // "--set bodies.bar.velocity=0 0 -190 m/s" unquoted: the shell split the value.
+    if (dynamic_cast<const CLI::ExtrasError*>(&e))
+      std::fprintf(stderr,
+                   "a --set value with spaces must be quoted for the shell: --set "
+                   "'bodies.bar.velocity=0 0 -190 m/s' or --set bodies.bar.velocity=\"0 0 -190 "
+                   "m/s\"\n");
     return code == 0 ? 0 : mpm::kExitBadInput;
   }
   opt.progress = progress == "bar"     ? mpm::ProgressMode::Bar
@@ -60,6 +71,7 @@ int main(int argc, char** argv) {
     }
     mpm::refuse_terminal_output(opt.output, "the result stream");
     mpm::check_output_file(opt.output, {opt.input});
+    if (!max_memory.empty()) opt.max_memory = mpm::parse_memory_size(max_memory, "--max-memory");
     return mpm::run_model(opt);
   });
 }

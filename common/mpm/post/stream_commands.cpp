@@ -217,7 +217,7 @@ std::vector<const Column*> particle_columns(const Frame& frame,
 }
 
 /// The CSV of particles: a comment with the time and step, a header, a row per particle.
-void write_particles_csv(std::FILE* f, const Frame& frame,
+void write_particles_csv(std::FILE* f, const std::string& path, const Frame& frame,
                          const std::vector<const Column*>& picked) {
   std::fprintf(f, "# t = %.10g s, step %lld\n", frame.time, (long long)frame.step);
   bool first = true;
@@ -236,6 +236,7 @@ void write_particles_csv(std::FILE* f, const Frame& frame,
         first = false;
       }
     std::fprintf(f, "\n");
+    check_written(f, path);
   }
 }
 
@@ -296,6 +297,7 @@ int post_history(const HistoryArgs& a) {
       for (std::size_t k = 0; k < pick.size(); ++k)
         std::fprintf(f, "%s%.10g", k ? "," : "", h.values[r * nc + pick[k]]);
       std::fprintf(f, "\n");
+      check_written(f, a.output);
     }
   };
   const StreamSummary s = read_stream(a.input, v);
@@ -324,7 +326,7 @@ int post_particles(const ParticlesArgs& a) {
   }
   const std::vector<const Column*> picked = particle_columns(*chosen, a.columns);
   std::FILE* f = open_output(a.output);
-  write_particles_csv(f, *chosen, picked);
+  write_particles_csv(f, a.output, *chosen, picked);
   close_output(f, a.output);
   return conclude(a.input, s, std::size_t(index));
 }

@@ -1,6 +1,7 @@
 #include "mpm/run/run.hpp"
 
 #include <omp.h>
+#include <toml++/toml.h>
 
 #include <atomic>
 #include <cmath>
@@ -10,10 +11,13 @@
 #include <memory>
 #include <sstream>
 
+#include "mpm/core/cli.hpp"
 #include "mpm/core/error.hpp"
+#include "mpm/core/units.hpp"
 #include "mpm/core/version.hpp"
 #include "mpm/grid/lattice.hpp"
 #include "mpm/run/restart.hpp"
+#include "mpm/scene/particles.hpp"
 #include "mpm/solver/explicit/explicit_solver.hpp"
 #include "mpm/solver/explicit/graded_solver.hpp"
 #include "mpm/solver/explicit/sparse_solver.hpp"
@@ -67,13 +71,59 @@ struct Model {
   Frame frame;
 };
 
-Model read_model(const std::string& path) {
+/// Refuses, before the particles are read, a model whose run would need more than `limit`
+/// bytes: its particles (from mpm-prep's INFO record) times a run's bytes a particle and the
+/// model's, and a grid window of at most a node a particle and at most the domain.
+void check_model_memory(const std::string& name, const std::string& scene_text,
+                        const std::string& info, const RunOptions& opt) {
+  const double limit = opt.max_memory > 0 ? opt.max_memory : machine_memory();
+  if (!(limit > 0)) return;
+  double particles = 0;
+  try {
+    const toml::table t = toml::parse(info);
+    if (const auto* bodies = t["bodies"].as_array())
+      for (const auto& b : *bodies)
+        if (const auto* table = b.as_table()) particles += (*table)["particles"].value_or(0.0);
+  } catch (const toml::parse_error&) {
+    return;  // not mpm-prep's info: the frame's own checks apply
+  }
+  const Scene scene = parse_scene(scene_text, name + " (scene)", "", opt.overrides);
+  double nodes = 1;
+  if (scene.grid.domain_given) {
+    const Lattice lat = make_lattice(scene);
+    for (int a = 0; a < scene.dimension; ++a) nodes *= lat.cells[a] + 1.0;
+  }
+  const int d = scene.dimension;
+  const double model_bytes = 4 + 1 + 1 + 2 * d * 8 + 8 + 8;  // the model's columns as read
+  const double need = particles * (run_particle_bytes(scene) + model_bytes) +
+                      std::min(nodes, particles) * grid_node_bytes(d);
+  if (need > limit)
+    throw InputError(name, "the model holds " + format_count(particles) +
+                               " particles; running it would need about " + format_bytes(need) +
+                               " of memory, more than the limit of " + format_bytes(limit) +
+                               " (--max-memory; by default the machine's memory): run it on a "
+                               "larger machine, or make a coarser model with mpm-prep");
+}
+
+Model read_model(const RunOptions& opt) {
+  const std::string& path = opt.input;
   Model model;
   bool have_scene = false, have_frame = false;
   StreamVisitor v;
   v.scene = [&](const std::string& text) {
     model.scene_text = text;
     have_scene = true;
+  };
+  v.info = [&](const std::string& text) {
+    if (!have_frame && text.find("tool = \"mpm-run\"") != std::string::npos)
+      throw InputError(path == "-" ? "stdin" : path,
+                       "this is a result from mpm-run, not a model: to continue it from its "
+                       "last checkpoint use mpm-run --restart " +
+                           path +
+                           "; to run again from t = 0, run mpm-run on the model from "
+                           "mpm-prep");
+    if (have_scene && !have_frame)
+      check_model_memory(path == "-" ? "stdin" : path, model.scene_text, text, opt);
   };
   v.frame = [&](Frame&& f) {
     if (!have_frame) model.frame = std::move(f), have_frame = true;
@@ -608,7 +658,7 @@ int run_model(const RunOptions& opt) {
       throw InputError("--set " + kv.substr(0, kv.find('=')),
                        "bodies are fixed once mpm-prep has made the particles; pass this "
                        "override to mpm-prep instead");
-  Model model = read_model(opt.input);
+  Model model = read_model(opt);
   const std::string name = (opt.input == "-" ? std::string("stdin") : opt.input) + " (scene)";
   const Scene scene = parse_scene(model.scene_text, name, "", opt.overrides);
   const Lattice lattice = make_lattice(scene);

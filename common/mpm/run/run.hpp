@@ -16,7 +16,8 @@ struct RunOptions {
   std::string strategy = "colored";    ///< particle-to-grid scatter strategy
   bool deterministic = false;          ///< results independent of the thread count
   ProgressMode progress = ProgressMode::Auto;
-  std::string restart;  ///< result stream to continue from its last checkpoint ("": none)
+  std::string restart;    ///< result stream to continue from its last checkpoint ("": none)
+  double max_memory = 0;  ///< bytes the run may need (--max-memory); 0: the machine's memory
 };
 
 /// Runs a model to its end time (or, with `restart`, continues a result stream from its last

@@ -73,6 +73,15 @@ struct ColumnNeeds {
 };
 ColumnNeeds column_needs(const Scene& scene);
 
+/// Bytes of one particle in a run (the model's columns and the state columns of
+/// prepare_columns), for the estimates of mpm-prep and the memory check of mpm-run.
+double run_particle_bytes(const Scene& scene);
+
+/// Bytes of one node of the dense grid window: its mass and 3 vectors of d components.
+inline double grid_node_bytes(int dim) {
+  return 8 + 3 * dim * 8;
+}
+
 /// Adds the state columns a run needs to a model's columns (sigma, e and the optional ones),
 /// initialised to the unstressed state (T to each material's room temperature; thickness to 1
 /// in plane stress; f_ext from the

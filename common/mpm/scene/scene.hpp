@@ -135,6 +135,9 @@ struct BodySpec {
   /// Rigid bodies: bit a set = the contact is frictionless along axis a (the nodes the body
   /// touches keep the material's velocity in that component); 0 = no-slip (all components).
   std::uint8_t slip_axes = 0;
+  /// The domain may cut the body (its part outside gets no particles); else mpm-prep refuses a
+  /// body the domain cuts anywhere but at a symmetry plane.
+  bool cut_by_domain = false;
   SourceLoc loc;
 };
 
@@ -275,6 +278,9 @@ struct Scene {
   SolverSpec solver;
   OutputSpec output;
   std::string toml;  ///< the scene as TOML text after overrides, as stored in streams
+  /// Values that are valid but implausible ("file:line: key: what and the likely fix"), found
+  /// by the parser; mpm-prep prints them as warnings.
+  std::vector<std::string> warnings;
 
   /// Index of a material by name, -1 if absent.
   int material_index(const std::string& name) const;
