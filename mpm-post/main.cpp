@@ -86,6 +86,11 @@ CLI::App* add_debris(CLI::App& app, mpm::DebrisArgs& a) {
   sub->add_option(
       "--plane", a.plane,
       "reference plane along the axis, e.g. \"6.36 mm\" (default: the target's rear face)");
+  sub->add_option("--face", a.face,
+                  "the target's face the front is measured from: rear or impact (the cloud is "
+                  "what lies behind the rear face either way)")
+      ->check(CLI::IsMember({"rear", "impact"}))
+      ->capture_default_str();
   sub->add_option("--target", a.target, "target body (default: the first body at rest)");
   sub->add_option("--projectile", a.projectile, "projectile body (default: the fastest body)");
   sub->add_option(
@@ -102,6 +107,9 @@ CLI::App* add_debris(CLI::App& app, mpm::DebrisArgs& a) {
       ->capture_default_str();
   sub->add_option("--link", a.link,
                   "linking length of fragments, e.g. \"1 mm\" (default: the grid's cell size)");
+  sub->add_flag("--escaped", a.escaped,
+                "also count the particles that left the domain by the frame's time (the run's "
+                "escape records), and those of them that left behind the plane");
   sub->add_option("--expect-front", a.expect_front, "reference front, e.g. \"200 mm\"");
   sub->add_option("--expect-width", a.expect_width, "reference width, e.g. \"145 mm\"");
   sub->add_option("--symmetry", a.symmetry,
@@ -156,6 +164,11 @@ CLI::App* add_profile(CLI::App& app, mpm::ProfileArgs& a) {
   sub->add_option("--body", a.body, "only this body's particles");
   sub->add_option("--bins", a.profile.bins,
                   "average in this many equal bins along the line (default: one row per particle)");
+  sub->add_option("--weight", a.weight,
+                  "what a particle weighs in a bin's mean (and the weight column): volume "
+                  "(m/rho: a mean over space) or mass (m: a mean over material); --grid: mass")
+      ->check(CLI::IsMember({"volume", "mass"}))
+      ->capture_default_str();
   sub->add_flag("--grid", a.grid,
                 "on the grid: project the field onto the run's grid nodes (linear shape "
                 "functions, mass-weighted) and profile the nodes near the line");

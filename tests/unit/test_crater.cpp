@@ -88,7 +88,8 @@ TEST(Crater, SphericalCapCraterGivesItsDepthAndDiameter) {
   // ball at its bottom.
   const double d = 3.3e-3, D = 8.2e-3, R = (D * D / 4 + d * d) / (2 * d);
   const Vec3 c(0, 0, R - d);
-  const Points later = model([&](const Vec3& x) { return (x - c).norm() < R; }, Vec3(0, 0, 2e-3 - d));
+  const Points later =
+      model([&](const Vec3& x) { return (x - c).norm() < R; }, Vec3(0, 0, 2e-3 - d));
   const CraterResult q = CraterMeter(quarter, start.frame(0), {}).measure(later.frame(30e-6));
   EXPECT_EQ(q.symmetry.images(), 4);
   EXPECT_EQ(q.axis, 2);
@@ -124,8 +125,8 @@ TEST(Crater, HoleThroughThePlateIsPerforatedWithItsDiameter) {
   const Points start = model([](const Vec3&) { return false; }, Vec3(0, 0, 2.5e-3));
   // A hole 5.2 mm across through the plate, its rim bulged; the ball 4 mm behind the plate.
   const double Dh = 5.2e-3;
-  const Points later = model([&](const Vec3& x) { return std::hypot(x.x(), x.y()) < Dh / 2; },
-                             Vec3(0, 0, -16e-3));
+  const Points later =
+      model([&](const Vec3& x) { return std::hypot(x.x(), x.y()) < Dh / 2; }, Vec3(0, 0, -16e-3));
   const CraterResult q = CraterMeter(quarter, start.frame(0), {}).measure(later.frame(40e-6));
   EXPECT_TRUE(q.perforated);
   EXPECT_NEAR(q.diameter, Dh, kS);

@@ -87,6 +87,18 @@ TEST(Debris, PlaneAxisPercentilesAndMaximum) {
   EXPECT_NEAR(r.width_p995, 0.995, tol);
   EXPECT_NEAR(r.width, 0.995, tol);
 
+  // From the impact face (plate centres from x = 0, surface at -0.5 mm): the same cloud, its
+  // distances 6 mm longer (the plate's thickness); the width does not change.
+  DebrisOptions impact;
+  impact.face = DebrisFace::Impact;
+  const DebrisResult f = DebrisMeter(scene, start.frame(0), impact).measure(later.frame(30e-6));
+  EXPECT_NEAR(f.face_plane, -0.5e-3, 1e-15);
+  EXPECT_EQ(f.cloud, 1000u);
+  EXPECT_NEAR(f.front_max, 1.006, tol);
+  EXPECT_NEAR(f.front_p995, 1.001, tol);
+  EXPECT_NEAR(f.front_p999, 1.005, tol);
+  EXPECT_EQ(f.width_p995, r.width_p995);
+
   DebrisOptions p90;
   p90.percentile = 90;
   const DebrisResult q = DebrisMeter(scene, start.frame(0), p90).measure(later.frame(30e-6));

@@ -58,6 +58,7 @@ struct DebrisArgs {
   std::string time;              ///< the frame nearest this time; empty: the last
   std::string axis;              ///< impact axis "x", "y" or "z"; empty: the projectile's velocity
   std::string plane;             ///< reference plane (length); empty: the target's rear face
+  std::string face = "rear";     ///< the face the front is measured from: "rear" or "impact"
   std::string target;            ///< target body; empty: the first body at rest
   std::string projectile;        ///< projectile body; empty: the fastest body
   std::string expect_front;      ///< reference front (length); empty: none
@@ -65,6 +66,7 @@ struct DebrisArgs {
   std::string link;              ///< fragments' linking length; empty: the grid's cell size
   double percentile = 99.5;      ///< the headline front and width are this percentile, %
   std::size_t min_fragment = 1;  ///< only fragments of at least this many particles count
+  bool escaped = false;          ///< also count the particles that left the domain (ESCP)
   bool json = false;             ///< print JSON (SI units)
   std::string symmetry;          ///< mirror planes (option_symmetry); empty: the scene's
 };
@@ -97,6 +99,7 @@ struct ProfileArgs {
   ProfileOptions profile;          ///< field and bins as given; the rest is set from the above
   bool json = false;               ///< print JSON (SI units)
   bool grid = false;               ///< profile the field projected onto the run's grid nodes
+  std::string weight = "volume";   ///< bins' means weighted by particle "volume" or "mass"
 };
 int post_profile(const ProfileArgs& args);
 

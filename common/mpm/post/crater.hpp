@@ -29,8 +29,8 @@ struct CraterResult {
   int axis = 2, direction = 1;     ///< the impact runs along direction * axis
   Vec3 axis_point = Vec3::Zero();  ///< a point of the crater's axis (the projectile's centre)
   double spacing = 0;              ///< the target's particle spacing, m
-  double surface = 0;     ///< position of the target's original front surface along the axis, m
-  double thickness = 0;   ///< the whole target's original thickness along the axis, m
+  double surface = 0;       ///< position of the target's original front surface along the axis, m
+  double thickness = 0;     ///< the whole target's original thickness along the axis, m
   bool perforated = false;  ///< no target material is left on the axis through the thickness
   /// Crater depth below the original front surface (the deepest floor inside the crater), m;
   /// perforated: the thickness.

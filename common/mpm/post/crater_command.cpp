@@ -42,8 +42,9 @@ void print_crater_text(const CraterResult& r) {
       r.target.c_str(), r.time * 1e6, r.direction > 0 ? "+" : "-", ax, r.axis_point.x() * 1e3,
       r.axis_point.y() * 1e3, r.axis_point.z() * 1e3);
   if (!r.symmetry.describe().empty()) std::printf("  %s\n", r.symmetry.describe().c_str());
-  std::printf("  original front surface %c = %.4g mm, thickness %.4g mm, particle spacing %.4g mm\n",
-              ax, r.surface * 1e3, r.thickness * 1e3, r.spacing * 1e3);
+  std::printf(
+      "  original front surface %c = %.4g mm, thickness %.4g mm, particle spacing %.4g mm\n", ax,
+      r.surface * 1e3, r.thickness * 1e3, r.spacing * 1e3);
   if (r.perforated)
     std::printf(
         "  perforated: hole diameter = %.3f mm (the narrowest through the thickness), depth = "

@@ -223,8 +223,8 @@ std::vector<std::size_t> fragment_sizes(const std::vector<Vec3>& points, double 
 
 DebrisMeter::DebrisMeter(const Scene& scene, const Frame& first, const DebrisOptions& options)
     : opt_(options), symmetry_(options.symmetry.value_or(scene_symmetry(scene))) {
-  const Impact im = find_impact(scene, first, symmetry_,
-                                {opt_.axis, opt_.projectile, opt_.target}, "debris");
+  const Impact im =
+      find_impact(scene, first, symmetry_, {opt_.axis, opt_.projectile, opt_.target}, "debris");
   dim_ = im.dimension;
   axisymmetric_ = scene.axisymmetric;
   axis_ = im.axis;
@@ -233,6 +233,9 @@ DebrisMeter::DebrisMeter(const Scene& scene, const Frame& first, const DebrisOpt
   // The reference plane: the whole target's rear face (surface: centres + half a spacing).
   const double spacing = scene.bodies[im.target].spacing(scene.grid.cell_size);
   plane_ = opt_.plane ? *opt_.plane : im.direction * (im.rear + 0.5 * spacing);
+  // The face the front is measured from: the rear face, or the struck face (surface).
+  face_plane_ =
+      opt_.face == DebrisFace::Impact ? im.direction * (im.front - 0.5 * spacing) : plane_;
   link_ = opt_.link > 0 ? opt_.link : scene.grid.cell_size;
   if (opt_.min_fragment < 1) throw InputError("--min-fragment", "expected at least 1 particle");
 }
@@ -244,6 +247,8 @@ DebrisResult DebrisMeter::measure(const Frame& frame) const {
   r.axis = axis_;
   r.direction = direction_;
   r.plane = plane_;
+  r.face = opt_.face;
+  r.face_plane = face_plane_;
   r.axis_point = point_;
   r.total = whole.particles;
   r.percentile = opt_.percentile;
@@ -262,7 +267,7 @@ DebrisResult DebrisMeter::measure(const Frame& frame) const {
     double r2 = 0;
     for (int a = 0; a < dim_; ++a)
       if (a != axis_) r2 += (p[a] - point_[a]) * (p[a] - point_[a]);
-    front.push_back(d);
+    front.push_back(direction_ * (p[axis_] - face_plane_));
     width.push_back(2 * std::sqrt(r2));
     cloud.push_back(p);
   }

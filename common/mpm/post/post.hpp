@@ -57,6 +57,9 @@ class TaylorMeter {
   int body_ = 0;
 };
 
+/// The face of the struck plate the front is measured from.
+enum class DebrisFace { Rear, Impact };
+
 /// Debris cloud measures (hypervelocity impact).
 struct DebrisOptions {
   int axis = -1;                ///< impact axis 0, 1, 2; -1: the projectile's velocity direction
@@ -70,6 +73,9 @@ struct DebrisOptions {
   double link = 0;
   std::size_t min_fragment = 1;      ///< 1: every cloud particle counts
   std::optional<Symmetry> symmetry;  ///< the model's mirror planes; none: the scene's
+  /// The front is the distance from this face of the target (its surface at t = 0: outermost
+  /// particle centres plus half a spacing); the cloud is what lies behind `plane` either way.
+  DebrisFace face = DebrisFace::Rear;
 };
 
 struct DebrisResult {
@@ -95,6 +101,9 @@ struct DebrisResult {
   /// model, where a particle stands for a ring of mass proportional to its radius, or bodies of
   /// different spacings), else of their number (equal masses, or frames without masses).
   bool by_mass = false;
+  /// The face the front is measured from, and its position along the axis, m.
+  DebrisFace face = DebrisFace::Rear;
+  double face_plane = 0;
 };
 
 /// Fragments of a point set, friends of friends: points closer than `link` are in one
@@ -120,6 +129,7 @@ class DebrisMeter {
   Symmetry symmetry_;
   int axis_ = 0, direction_ = 1;
   double plane_ = 0;
+  double face_plane_ = 0;  ///< the plane the front is measured from
   Vec3 point_ = Vec3::Zero();
   int dim_ = 3;
   bool axisymmetric_ = false;

@@ -10,6 +10,7 @@
 
 #include "mpm/core/error.hpp"
 #include "mpm/post/arguments.hpp"
+#include "mpm/post/column_value.hpp"
 #include "mpm/scene/particles.hpp"
 
 namespace mpm {
@@ -170,14 +171,14 @@ WholeBody unfold(const Frame& frame, int dimension, const Symmetry& symmetry,
   if (!xc) throw InputError("frame", "the frames hold no column 'x'");
   if (!bodies.empty() && !bc) throw InputError("frame", "the frames hold no column 'body'");
   const auto* x = reinterpret_cast<const double*>(xc->data());
-  const auto* body = bc ? reinterpret_cast<const std::uint8_t*>(bc->data()) : nullptr;
   const Column* mc = frame.columns.find(col::m);
   const double* m = mc ? reinterpret_cast<const double*>(mc->data()) : nullptr;
   const std::size_t n = frame.columns.size();
   const int images = symmetry.images();
   WholeBody w;
   for (std::size_t i = 0; i < n; ++i) {
-    if (!bodies.empty() && std::find(bodies.begin(), bodies.end(), int(body[i])) == bodies.end())
+    if (!bodies.empty() &&
+        std::find(bodies.begin(), bodies.end(), int(column_value(*bc, i, 0))) == bodies.end())
       continue;
     ++w.particles;
     Vec3 p = Vec3::Zero();

@@ -33,6 +33,24 @@ const char* face_name(int face) {
 
 namespace {
 
+/// The particles that left the domain since the last ESCP record (before the next frame or
+/// checkpoint), as an ESCP record stamped with the step and time (s); the log is emptied.
+void write_escapes(StreamWriter& out, EscapeLog& log, long step, double time) {
+  if (log.size() == 0) return;
+  Frame e;
+  e.step = step;
+  e.time = time;
+  std::swap(e.columns, log.columns());
+  try {
+    out.write_escapes(e);
+  } catch (...) {
+    std::swap(e.columns, log.columns());
+    throw;
+  }
+  std::swap(e.columns, log.columns());
+  log.clear();
+}
+
 /// Peak resident memory of this process (VmHWM), bytes; 0 when unknown.
 double peak_memory() {
   std::ifstream f("/proc/self/status");
@@ -148,6 +166,12 @@ class History {
     const char* axes[3] = {"momentum_x", "momentum_y", "momentum_z"};
     for (int a = 0; a < dim; ++a) add(axes[a], "kg m/s");
     add("particles", "-");
+    if (scene.solver.on_exit == OnExit::Remove) {  // what left, so that the totals close
+      removed_ = true;
+      add("removed_mass", "kg");
+      const char* out[3] = {"removed_momentum_x", "removed_momentum_y", "removed_momentum_z"};
+      for (int a = 0; a < dim; ++a) add(out[a], "kg m/s");
+    }
     for (int f = 0; f < 2 * dim; ++f)
       if (bc.face[f] != BoundaryType::Free) {
         faces_.push_back(f);
@@ -173,6 +197,8 @@ class History {
   }
   template <class Solver>
   void record(const Solver& s, double dt) {
+    if (s.steps() == last_step_) return;  // one row per time
+    last_step_ = s.steps();
     const Balance& b = s.balance();
     // Extensive values as totals: per metre in plane strain, the whole ring in axisymmetry.
     const double k = factor_;
@@ -181,6 +207,10 @@ class History {
                                k * b.removed,     k * b.total(),  k * b.leapfrog_total};
     for (int a = 0; a < dim_; ++a) row.push_back(k * b.momentum[a]);
     row.push_back(double(const_cast<Solver&>(s).particles().size()));
+    if (removed_) {
+      row.push_back(k * b.removed_mass);
+      for (int a = 0; a < dim_; ++a) row.push_back(k * b.removed_momentum[a]);
+    }
     for (int f : faces_) row.push_back(factor_ * s.face_force()[f]);
     for (int b : rigid_)
       for (int a = 0; a < dim_; ++a) row.push_back(factor_ * s.rigid_force()[b][a]);
@@ -211,7 +241,9 @@ class History {
   int dim_;
   double factor_;
   bool implicit_;
-  ImplicitWork last_;  ///< totals at the previous row
+  ImplicitWork last_;     ///< totals at the previous row
+  long last_step_ = -1;   ///< step of the last row
+  bool removed_ = false;  ///< columns of what left the domain (solver.on_exit = "remove")
   std::vector<int> faces_, rigid_;
   HistoryBlock block_;
 };
@@ -372,6 +404,7 @@ class TimeLoop {
   void emit_frame(std::uint32_t flags) {
     ScopedTimer timer(solver_.timers(), t_output_);
     history_.flush(*out_);
+    write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
     emit_grid();
     write_particles(flags, [&](const Frame& f) { out_->write_frame(f, o_.fields, o_.precision); });
   }
@@ -382,6 +415,7 @@ class TimeLoop {
       ScopedTimer timer(solver_.timers(), t_output_);
       solver_.settle();
       history_.flush(*out_);
+      write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
       StateValues s;
       solver_.save_state(s);
       s.set("frame", frame_);
@@ -432,8 +466,12 @@ class TimeLoop {
 
 template <class Solver>
 void TimeLoop<Solver>::advance() {
+  const double pace = solver_.stable_dt();  // the step taken when no frame time is near
   double dt = next_step(solver_, next_frame());
-  solver_.step(dt);
+  if constexpr (kImplicit)
+    solver_.step(dt);
+  else
+    solver_.step(dt, pace);  // the leapfrog energy evaluated at the pace, not the cut step
   if constexpr (kImplicit) dt = solver_.last_dt();  // cut when Newton failed
   if (solver_.time() >= next_history_ * (1 - 1e-12) || o_.history_interval <= 0) {
     history_.record(solver_, dt);
@@ -441,7 +479,7 @@ void TimeLoop<Solver>::advance() {
     if (history_.pending() >= 4096) history_.flush(*out_);
   }
   if (solver_.time() >= next_frame() * (1 - 1e-12)) {
-    if (history_.pending() == 0 || o_.history_interval > 0) history_.record(solver_, dt);
+    history_.record(solver_, dt);  // a row at each frame time (one: record skips a repeat)
     emit_frame(frame_ == o_.frames ? std::uint32_t(kFrameFinal) : 0u);
     ++frame_;
   }
@@ -489,6 +527,7 @@ int TimeLoop<Solver>::operator()() {
   }
   const double loop_wall = omp_get_wtime() - loop_start;  // the time loop, output included
   history_.flush(*out_);
+  write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
   out_->write_end(status_, message_);
   out_->close();
   report(loop_wall);

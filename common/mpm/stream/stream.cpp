@@ -113,6 +113,7 @@ bool known_type(std::uint32_t type) {
     case RecordType::Frame:
     case RecordType::History:
     case RecordType::Grid:
+    case RecordType::Escape:
     case RecordType::Checkpoint:
     case RecordType::End:
       return true;
@@ -266,6 +267,10 @@ void StreamWriter::write_record(RecordType type, const std::vector<std::byte>& p
 void StreamWriter::write_frame(const Frame& frame, const std::vector<std::string>& fields,
                                Precision precision) {
   write_columns(RecordType::Frame, {}, frame, fields, precision);
+}
+
+void StreamWriter::write_escapes(const Frame& escaped) {
+  write_columns(RecordType::Escape, {}, escaped, {}, Precision::Float64);
 }
 
 void StreamWriter::write_columns(RecordType type, const std::string& prefix, const Frame& frame,
@@ -521,7 +526,8 @@ void StreamReader::skip() {
 }
 
 Frame StreamReader::read_frame() {
-  if (!pending_ || type_ != std::uint32_t(RecordType::Frame))
+  if (!pending_ ||
+      (type_ != std::uint32_t(RecordType::Frame) && type_ != std::uint32_t(RecordType::Escape)))
     throw std::logic_error("StreamReader::read_frame: the current record is not a frame");
   return read_frame_body();
 }
@@ -691,6 +697,12 @@ StreamSummary read_stream(const std::string& path, const StreamVisitor& visitor)
           else
             r.skip();
           break;
+        case RecordType::Escape:
+          if (visitor.escapes)
+            frame = r.read_frame();
+          else
+            r.skip();
+          break;
         default:
           r.skip();  // a record type of a later minor version
       }
@@ -715,6 +727,9 @@ StreamSummary read_stream(const std::string& path, const StreamVisitor& visitor)
         break;
       case RecordType::Grid:
         if (visitor.grid) visitor.grid(std::move(grid));
+        break;
+      case RecordType::Escape:
+        if (visitor.escapes) visitor.escapes(std::move(frame));
         break;
       case RecordType::End:
         s.ended = true;

@@ -17,8 +17,8 @@
 namespace mpm {
 
 inline constexpr std::uint16_t kStreamVersionMajor = 1;  ///< readers refuse other majors
-inline constexpr std::uint16_t kStreamVersionMinor =
-    2;  ///< readers accept any minor (1: GRID, 2: CHKP)
+/// Readers accept any minor (1: GRID; 2: CHKP; 3: ESCP).
+inline constexpr std::uint16_t kStreamVersionMinor = 3;
 
 /// Record types (little-endian fourcc).
 enum class RecordType : std::uint32_t {
@@ -29,6 +29,7 @@ enum class RecordType : std::uint32_t {
   End = 0x53444E45,      ///< "ENDS": status and message; absent when the writer was killed
   Grid = 0x44495247,     ///< "GRID": a graded grid's nodes and cells (since 1.1; graded_grid.hpp)
   Checkpoint = 0x504B4843,  ///< "CHKP": a solver's whole state, for mpm-run --restart (since 1.2)
+  Escape = 0x50435345,      ///< "ESCP": particles that left the domain, as a frame (since 1.3)
 };
 /// "SCEN", "FRAM", ... for messages; "?xyz" style hex for unknown codes.
 std::string record_name(std::uint32_t type);
@@ -83,6 +84,9 @@ class StreamWriter {
   /// Float32 precision stores f64 columns as f32, except "x" (positions keep f64).
   void write_frame(const Frame& frame, const std::vector<std::string>& fields = {},
                    Precision precision = Precision::Float64);
+  /// Writes an ESCP record: the particles that left the domain, every column in f64 (the
+  /// layout of a frame; docs/format.md).
+  void write_escapes(const Frame& escaped);
   /// Writes a CHKP record: the state values, then every column of the frame as stored (f64
   /// stays f64).
   void write_checkpoint(const StateValues& state, const Frame& frame);
@@ -101,7 +105,7 @@ class StreamWriter {
   const std::string& path() const { return path_; }
 
  private:
-  /// Writes a FRAM or CHKP record: `prefix` (CHKP's state values), then the frame.
+  /// Writes a FRAM, ESCP or CHKP record: `prefix` (CHKP's state values), then the frame.
   void write_columns(RecordType type, const std::string& prefix, const Frame& frame,
                      const std::vector<std::string>& fields, Precision precision);
   void begin_record(RecordType type, std::uint64_t length);
@@ -141,8 +145,8 @@ class StreamReader {
   bool next(std::uint32_t& type);
   /// The payload of the current record (checked against its CRC).
   std::vector<std::byte> read_payload();
-  /// The current record as a frame (must be a FRAM record), decoded straight into columns;
-  /// f32 columns are widened to f64. Checked against its CRC.
+  /// The current record as a frame (must be a FRAM or ESCP record), decoded straight into
+  /// columns; f32 columns are widened to f64. Checked against its CRC.
   Frame read_frame();
   /// The current record as a checkpoint (must be a CHKP record). Checked against its CRC.
   Checkpoint read_checkpoint();
@@ -200,6 +204,8 @@ struct StreamVisitor {
   std::function<void(int, const std::string&)> end;
   /// GRID payloads (decode_grid in grid_record.hpp); skipped when empty.
   std::function<void(std::vector<std::byte>&&)> grid;
+  /// ESCP records: particles that left the domain, as a frame (since 1.2); skipped when empty.
+  std::function<void(Frame&&)> escapes;
   bool want_frames = true;  ///< false: frames are skipped without decoding
 };
 

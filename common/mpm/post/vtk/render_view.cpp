@@ -60,8 +60,8 @@ Section parse_section(const std::string& text, int dim) {
                      "expected a plane such as \"x = 0\" or \"y = 2.5 mm\", got '" + text + "'");
   s.axis = axis[0] - 'x';
   if (s.axis >= dim)
-    throw InputError("--section",
-                     "a " + std::to_string(dim) + "D frame has no " + axis + " axis: '" + text + "'");
+    throw InputError("--section", "a " + std::to_string(dim) + "D frame has no " + axis +
+                                      " axis: '" + text + "'");
   s.position = option_quantity(trim(text.substr(eq + 1)), dim::length, "--section");
   return s;
 }
@@ -99,8 +99,8 @@ ViewAxes view_axes(const std::string& view, int dim, const Section& section, boo
   const auto& d = v.dir;
   const auto& u = v.up;
   v.right = {d[1] * u[2] - d[2] * u[1], d[2] * u[0] - d[0] * u[2], d[0] * u[1] - d[1] * u[0]};
-  const double n = std::sqrt(v.right[0] * v.right[0] + v.right[1] * v.right[1] +
-                             v.right[2] * v.right[2]);
+  const double n =
+      std::sqrt(v.right[0] * v.right[0] + v.right[1] * v.right[1] + v.right[2] * v.right[2]);
   for (double& c : v.right) c /= n;
   v.text = "seen along " + axis_name(v.dir) + " (" + axis_name(v.right) + " right, " +
            axis_name(v.up) + " up)";
@@ -128,8 +128,8 @@ Drawn drawn_particles(const Column& x, const std::vector<std::uint32_t>& keep,
     const auto p = position(x, i);
     for (int k = 0; k < images; ++k) {
       const Vec3 q = symmetry.point_image(Vec3(p[0], p[1], p[2]), k);
-      if (section.axis >= 0 &&
-          (d.keep_greater ? q[section.axis] < section.position : q[section.axis] > section.position))
+      if (section.axis >= 0 && (d.keep_greater ? q[section.axis] < section.position
+                                               : q[section.axis] > section.position))
         continue;
       d.xyz.insert(d.xyz.end(), {float(q[0]), float(q[1]), float(q[2])});
       d.values.push_back(field.values[i]);
@@ -139,8 +139,8 @@ Drawn drawn_particles(const Column& x, const std::vector<std::uint32_t>& keep,
   return d;
 }
 
-void add_scale_bar(vtkRenderer* overlay, const double vp[4], int w, int h,
-                   double parallel_scale, const std::string& caption) {
+void add_scale_bar(vtkRenderer* overlay, const double vp[4], int w, int h, double parallel_scale,
+                   const std::string& caption) {
   // Pixels per metre of the parallel camera: the viewport's height spans 2 parallel_scale.
   const double vp_w = (vp[2] - vp[0]) * w, vp_h = (vp[3] - vp[1]) * h;
   const double ppm = vp_h / (2 * parallel_scale);

@@ -2,12 +2,12 @@
 /// What a picture looks at (internal to mpm_vtk): the section plane, the camera's direction,
 /// the particles drawn (the whole body of a quarter or half model: mirror images), and the
 /// annotations that say so (a scale bar in a length unit, the view direction).
+#include <vtkRenderer.h>
+
 #include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include <vtkRenderer.h>
 
 #include "mpm/post/symmetry.hpp"
 #include "mpm/post/vtk/render_fields.hpp"
@@ -17,7 +17,7 @@ namespace mpm::vtk_internal {
 
 /// A section plane x_axis = position; the picture keeps one side and looks square at the cut.
 struct Section {
-  int axis = -1;  ///< -1: no section
+  int axis = -1;        ///< -1: no section
   double position = 0;  ///< m
 };
 
