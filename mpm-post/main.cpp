@@ -53,6 +53,14 @@ CLI::App* add_vtk(CLI::App& app, mpm::VtkArgs& a) {
   return sub;
 }
 
+/// The --symmetry option of the measures and render; `what` says what the planes change.
+void add_symmetry(CLI::App* sub, std::string& symmetry, const std::string& what) {
+  sub->add_option("--symmetry", symmetry,
+                  "mirror planes of a quarter or half model, e.g. \"x = 0, y = 0 mm\", or "
+                  "\"none\"" +
+                      what + " (default: the scene's slip faces through a body)");
+}
+
 CLI::App* add_taylor(CLI::App& app, mpm::TaylorArgs& a) {
   auto* sub = app.add_subcommand(
       "taylor", "final length L and foot diameter D (mean caliper width) of a bar against a wall");
@@ -68,10 +76,7 @@ CLI::App* add_taylor(CLI::App& app, mpm::TaylorArgs& a) {
   sub->add_option("--expect-L", a.expect_L,
                   "reference length, e.g. \"16.2 mm\", to print the difference");
   sub->add_option("--expect-D", a.expect_D, "reference diameter, e.g. \"13.5 mm\"");
-  sub->add_option("--symmetry", a.symmetry,
-                  "mirror planes of a quarter or half model, e.g. \"x = 0, y = 0 mm\", or "
-                  "\"none\"; the measure is the whole body's (default: the scene's slip faces "
-                  "through a body)");
+  add_symmetry(sub, a.symmetry, "; the measure is the whole body's");
   sub->add_flag("--json", a.json, "print JSON (SI units)");
   return sub;
 }
@@ -112,10 +117,7 @@ CLI::App* add_debris(CLI::App& app, mpm::DebrisArgs& a) {
                 "escape records), and those of them that left behind the plane");
   sub->add_option("--expect-front", a.expect_front, "reference front, e.g. \"200 mm\"");
   sub->add_option("--expect-width", a.expect_width, "reference width, e.g. \"145 mm\"");
-  sub->add_option("--symmetry", a.symmetry,
-                  "mirror planes of a quarter or half model, e.g. \"x = 0, y = 0 mm\", or "
-                  "\"none\"; the measure is the whole body's (default: the scene's slip faces "
-                  "through a body)");
+  add_symmetry(sub, a.symmetry, "; the measure is the whole body's");
   sub->add_flag("--json", a.json, "print JSON (SI units)");
   return sub;
 }
@@ -133,9 +135,7 @@ CLI::App* add_crater(CLI::App& app, mpm::CraterArgs& a) {
                   "projectile body: the crater's axis runs through its initial centre (default: "
                   "the fastest body)");
   sub->add_option("--axis", a.axis, "impact axis x, y or z (default: the projectile's velocity)");
-  sub->add_option("--symmetry", a.symmetry,
-                  "mirror planes of a quarter or half model, e.g. \"x = 0, y = 0 mm\", or "
-                  "\"none\" (default: the scene's slip faces through a body)");
+  add_symmetry(sub, a.symmetry, "");
   sub->add_flag("--json", a.json, "print JSON (SI units)");
   return sub;
 }
@@ -201,10 +201,7 @@ CLI::App* add_render(CLI::App& app, mpm::RenderArgs& a) {
                   "cut at a plane in absolute coordinates, e.g. \"x = 0\" or \"y = 2.5 mm\" "
                   "(plain numbers in m): keeps the side with more particles and looks square at "
                   "the cut");
-  sub->add_option("--symmetry", a.symmetry,
-                  "mirror planes of a quarter or half model, e.g. \"x = 0, y = 0 mm\", or "
-                  "\"none\"; the picture shows the whole body (default: the scene's slip faces "
-                  "through a body)");
+  add_symmetry(sub, a.symmetry, "; the picture shows the whole body");
   sub->add_option("--clip", a.picture.clip,
                   "keep one side of a plane given as an OFFSET FROM THE MODEL'S CENTROID, e.g. "
                   "\"y>0\" (the centroid's side), \"y>2mm\"; for absolute planes use --section");
