@@ -34,8 +34,8 @@ void body_box(const Scene& scene, const BodySpec& body, Vec3& lo, Vec3& hi) {
 std::optional<double> density_at_pressure(const Material& mat, double p) {
   const double rho0 = mat.spec().density;
   const auto A_of = [&](double rho) {
-    double A, B, K;
-    mat.eos().coefficients(1, &rho, &A, &B, &K);
+    double A, B, K, e = 0;
+    mat.eos().coefficients(1, &rho, &e, &A, &B, &K);
     return A;
   };
   if (p == 0) return rho0;

@@ -38,7 +38,7 @@ inline const std::string thickness =
 inline constexpr std::uint8_t kRigidMaterial = 255;
 
 /// Read access to a body column of either width: u8, or u32 in models of more than 255
-/// bodies (stream format 1.2). Empty when there is no column.
+/// bodies (stream format 1.4). Empty when there is no column.
 class BodyIds {
  public:
   BodyIds() = default;
@@ -85,6 +85,15 @@ struct ColumnNeeds {
   bool failed = false;
 };
 ColumnNeeds column_needs(const Scene& scene);
+
+/// Bytes of one particle in a run (the model's columns and the state columns of
+/// prepare_columns), for the estimates of mpm-prep and the memory check of mpm-run.
+double run_particle_bytes(const Scene& scene);
+
+/// Bytes of one node of the dense grid window: its mass and 3 vectors of d components.
+inline double grid_node_bytes(int dim) {
+  return 8 + 3 * dim * 8;
+}
 
 /// Adds the state columns a run needs to a model's columns (sigma, e and the optional ones),
 /// initialised to the unstressed state (T to each material's room temperature; thickness to 1

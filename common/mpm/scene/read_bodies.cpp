@@ -44,7 +44,8 @@ const std::vector<std::string_view> kBodyKeys = {"name",
                                                  "angular_velocity",
                                                  "spin_centre",
                                                  "velocity_field",
-                                                 "stress_field"};
+                                                 "stress_field",
+                                                 "cut_by_domain"};
 
 /// The body's material, or none for a rigid body.
 void read_body_material(Reader& r, const Scene& scene, BodySpec& b) {
@@ -277,6 +278,7 @@ BodySpec read_body(Reader& r, const Scene& scene) {
   read_particles(r, b);
   read_slip(r, scene.dimension, b);
   read_initial_fields(r, scene, b);
+  b.cut_by_domain = r.boolean("cut_by_domain").value_or(false);
   r.finish();
   return b;
 }

@@ -19,7 +19,7 @@ struct SourceLoc {
 };
 
 enum class StrengthModel { Elastic, J2, JohnsonCook };
-enum class EosModel { Linear, MieGruneisen };
+enum class EosModel { Linear, MieGruneisen, Tillotson };
 
 /// Deviatoric strength. J2: sigma_y = A + B eps_p^n. Johnson-Cook multiplies by
 /// (1 + C ln(rate/rate0)) (1 - T*^m), T* = (T - T_room)/(T_melt - T_room).
@@ -38,7 +38,17 @@ struct StrengthSpec {
   bool thermal() const { return model == StrengthModel::JohnsonCook && m > 0; }
 };
 
+/// Tillotson's constants (docs/eos-tillotson.md); rho0 is the material's density.
+struct TillotsonSpec {
+  double a = 0, b = 0;         ///< thermal coefficients (a + b: Grueneisen's at rho0)
+  double A = 0, B = 0;         ///< linear and quadratic compression moduli, Pa
+  double E0 = 0;               ///< energy scale of omega = 1 + E / (E0 eta^2), J/kg
+  double E_iv = 0, E_cv = 0;   ///< incipient and complete vaporisation energies, J/kg
+  double alpha = 0, beta = 0;  ///< decay of the expanded branch's terms
+};
+
 /// Equation of state. Linear: p = K mu. Mie-Grueneisen (000, eq. 18) with internal energy.
+/// Tillotson: compressed, cold and hot expanded branches (docs/eos-tillotson.md).
 struct EosSpec {
   EosModel model = EosModel::Linear;
   double c0 = 0;      ///< bulk sound speed, m/s
@@ -47,6 +57,7 @@ struct EosSpec {
   /// Mie-Grueneisen in expansion (mu < 0): p = rho0 c0^2 mu + gamma0 E as 000 eq. 18 prints it
   /// (true), or without the energy term, as the seed authors' own code does (false).
   bool energy_in_expansion = true;
+  TillotsonSpec tillotson;  ///< model = Tillotson only
 };
 
 /// Failure: a failed particle keeps no deviatoric stress and carries no tension.
@@ -124,6 +135,9 @@ struct BodySpec {
   /// Rigid bodies: bit a set = the contact is frictionless along axis a (the nodes the body
   /// touches keep the material's velocity in that component); 0 = no-slip (all components).
   std::uint8_t slip_axes = 0;
+  /// The domain may cut the body (its part outside gets no particles); else mpm-prep refuses a
+  /// body the domain cuts anywhere but at a symmetry plane.
+  bool cut_by_domain = false;
   SourceLoc loc;
 };
 
@@ -245,6 +259,8 @@ struct OutputSpec {
   double history_interval = 0;      ///< s; 0: every step
   std::vector<std::string> fields;  ///< particle columns written in frames; empty: all
   Precision precision = Precision::Float64;
+  double checkpoint_time = 0;  ///< s of simulated time between checkpoints; 0: none
+  double checkpoint_wall = 0;  ///< s of wall-clock time between checkpoints; 0: none
 };
 
 struct Scene {
@@ -262,6 +278,9 @@ struct Scene {
   SolverSpec solver;
   OutputSpec output;
   std::string toml;  ///< the scene as TOML text after overrides, as stored in streams
+  /// Values that are valid but implausible ("file:line: key: what and the likely fix"), found
+  /// by the parser; mpm-prep prints them as warnings.
+  std::vector<std::string> warnings;
 
   /// Index of a material by name, -1 if absent.
   int material_index(const std::string& name) const;
