@@ -508,7 +508,8 @@ TEST(SceneErrors, InlineCases) {
        "name = \"bar\"\nmaterial = \"copper\"\nshape = \"sphere\"",
        "bodies.bar.name: duplicate body name 'bar' (first used at inline.toml:8)"},
       {"unknown shape", "shape = \"cylinder\"", "shape = \"cone\"", "shape",
-       "bodies.bar.shape: expected one of \"box\", \"cylinder\", \"sphere\", \"mesh\", got 'cone'"},
+       "bodies.bar.shape: expected one of \"box\", \"cylinder\", \"sphere\", \"ogive\", "
+       "\"mesh\", got 'cone'"},
       {"missing shape", "shape = \"cylinder\"\n", "", "[[bodies]]",
        "bodies.bar: missing required key 'shape'"},
       {"box without size", "shape = \"cylinder\"", "shape = \"box\"", "[[bodies]]",
@@ -516,7 +517,20 @@ TEST(SceneErrors, InlineCases) {
       {"key of another shape", "length = \"25.4 mm\"", "length = \"25.4 mm\"\nsize = \"1 1 1 mm\"",
        "size", "bodies.bar.size: not used with shape = \"cylinder\" (this key is for box)"},
       {"sphere with length", "shape = \"cylinder\"", "shape = \"sphere\"", "length",
-       "bodies.bar.length: not used with shape = \"sphere\" (this key is for cylinder)"},
+       "bodies.bar.length: not used with shape = \"sphere\" (this key is for cylinder and ogive)"},
+      {"ogive without crh", "shape = \"cylinder\"\nradius = \"3.8 mm\"",
+       "shape = \"ogive\"\ndiameter = \"7.6 mm\"", "[[bodies]]",
+       "bodies.bar: missing required key 'crh' (a number, e.g. 3.0; the nose's arc radius in "
+       "shank diameters, at least 0.5)"},
+      {"ogive with radius", "shape = \"cylinder\"", "shape = \"ogive\"\ndiameter = 0.0076\ncrh = 3",
+       "radius",
+       "bodies.bar.radius: not used with shape = \"ogive\" (this key is for cylinder and "
+       "sphere)"},
+      {"diameter on a cylinder", body_end, body_end + "\ndiameter = \"7.6 mm\"", "diameter",
+       "bodies.bar.diameter: not used with shape = \"cylinder\" (this key is for ogive)"},
+      {"2D ogive", "shape = \"cylinder\"\nradius = \"3.8 mm\"\nlength = \"25.4 mm\"",
+       "shape = \"ogive\"\ndiameter = \"7.6 mm\"\nlength = \"25.4 mm\"\ncrh = 3", "shape",
+       "bodies.bar.shape: shape \"ogive\" is not available in 2D scenes; use box or sphere"},
       {"2D mesh", "shape = \"cylinder\"\nradius = \"3.8 mm\"\nlength = \"25.4 mm\"",
        "shape = \"mesh\"\nfile = \"a.stl\"", "shape",
        "bodies.bar.shape: shape \"mesh\" is not available in 2D scenes; use box or sphere"},
@@ -837,6 +851,7 @@ void expect_same(const Scene& a, const Scene& b) {
     EXPECT_EQ(x.size, y.size);
     EXPECT_EQ(x.radius, y.radius);
     EXPECT_EQ(x.length, y.length);
+    EXPECT_EQ(x.crh, y.crh);
     EXPECT_EQ(x.mesh_path, y.mesh_path);
     EXPECT_EQ(x.scale, y.scale);
     EXPECT_EQ(x.rotate_deg, y.rotate_deg);

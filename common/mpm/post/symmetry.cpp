@@ -30,7 +30,8 @@ Mat3 placement(const BodySpec& b) {
   return R * b.scale.asDiagonal();
 }
 
-/// The extent of a primitive body's shape along each axis, m (lo, hi); none for a mesh (its file
+/// The extent of a primitive body's shape along each axis, m (lo, hi; an ogive's the box of its
+/// shank's cylinder); none for a mesh (its file
 /// is not in the stream).
 std::optional<std::pair<Vec3, Vec3>> shape_extent(const BodySpec& b) {
   const Mat3 A = placement(b);
@@ -45,6 +46,7 @@ std::optional<std::pair<Vec3, Vec3>> shape_extent(const BodySpec& b) {
       case ShapeKind::Sphere:
         h = b.radius * A.row(a).norm();
         break;
+      case ShapeKind::Ogive:       // inside its shank's cylinder: that box (the nose never wider)
       case ShapeKind::Cylinder: {  // from the base t to t + A (0, 0, length), radius r
         c = t[a] + 0.5 * b.length * A(a, 2);
         h = 0.5 * b.length * std::abs(A(a, 2)) + b.radius * std::hypot(A(a, 0), A(a, 1));

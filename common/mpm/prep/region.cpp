@@ -1,6 +1,6 @@
-// Bodies' regions: the primitives (box, cylinder, sphere; rectangle and disk in 2D) with exact
-// inside tests and volumes, the checks of a body's shape and placement, and the lattice fitted
-// around the bodies. Mesh regions (CGAL) live in mesh_region.cpp.
+// Bodies' regions: the primitives (box, cylinder, sphere, ogive; rectangle and disk in 2D) with
+// exact inside tests and volumes, the checks of a body's shape and placement, and the lattice
+// fitted around the bodies. Mesh regions (CGAL) live in mesh_region.cpp.
 #include "mpm/prep/region.hpp"
 
 #include <algorithm>
@@ -16,6 +16,7 @@
 #include "mpm/core/units.hpp"
 #include "mpm/prep/body_placement.hpp"
 #include "mpm/prep/mesh_region.hpp"
+#include "mpm/prep/ogive.hpp"
 
 namespace mpm {
 
@@ -29,6 +30,8 @@ const char* shape_name(ShapeKind k) {
       return "cylinder";
     case ShapeKind::Sphere:
       return "sphere";
+    case ShapeKind::Ogive:
+      return "ogive";
     case ShapeKind::Mesh:
       return "mesh";
   }
@@ -39,12 +42,13 @@ bool finite(const Vec3& v) {
   return v.allFinite();
 }
 
-/// Box, cylinder and sphere (rectangle and disk in 2D). contains() maps the point back to the
-/// local frame with the precomputed inverse placement, x_local = S^-1 R^T (x - t), and tests
+/// Box, cylinder, sphere and ogive (rectangle and disk in 2D). contains() maps the point back to
+/// the local frame with the precomputed inverse placement, x_local = S^-1 R^T (x - t), and tests
 /// the local shape exactly.
 class PrimitiveRegion final : public Region {
  public:
-  PrimitiveRegion(const BodySpec& body, int dim) : kind_(body.shape), dim_(dim) {
+  PrimitiveRegion(const BodySpec& body, int dim)
+      : kind_(body.shape), dim_(dim), ogive_(body.radius, body.length, body.crh) {
     Mat3 A = body_linear_map(body);
     Vec3 s = body.scale;
     t_ = body.translate;
@@ -95,6 +99,16 @@ class PrimitiveRegion final : public Region {
         volume_ = pi * r2_ * body.length * ascale;
         break;
       }
+      case ShapeKind::Ogive:
+        // Along world axis a the ogive reaches t_a + h(A^T e_a) and t_a - h(-A^T e_a), h its
+        // support function in the local frame.
+        for (int a = 0; a < 3; ++a) {
+          const Vec3 w = A.row(a).transpose();
+          lo_[a] = t_[a] - ogive_.support(-w);
+          hi_[a] = t_[a] + ogive_.support(w);
+        }
+        volume_ = ogive_.volume() * ascale;
+        break;
       case ShapeKind::Mesh:
         break;  // not a primitive
     }
@@ -110,6 +124,8 @@ class PrimitiveRegion final : public Region {
         return (dim_ == 2 ? p.x() * p.x() + p.y() * p.y() : p.squaredNorm()) <= r2_;
       case ShapeKind::Cylinder:
         return p.z() >= 0 && p.z() <= length_ && p.x() * p.x() + p.y() * p.y() <= r2_;
+      case ShapeKind::Ogive:
+        return ogive_.contains(p);
       case ShapeKind::Mesh:
         return false;
     }
@@ -170,14 +186,15 @@ class PrimitiveRegion final : public Region {
   Mat3 to_local_;
   Vec3 t_, half_, lo_, hi_;
   double r2_ = 0, length_ = 0, volume_ = 0;
+  Ogive ogive_;  ///< its geometry for ShapeKind::Ogive
 };
 
 /// Checks a body's shape parameters and placement; throws InputError at the offending key.
 void check_body_shape(const BodySpec& body, const Scene& scene) {
   const int dim = scene.dimension;
-  if (dim == 2 && (body.shape == ShapeKind::Cylinder || body.shape == ShapeKind::Mesh))
+  if (dim == 2 && body.shape != ShapeKind::Box && body.shape != ShapeKind::Sphere)
     throw InputError(body_where(scene, body, "shape"),
-                     "body '" + body.name + "' is a " + shape_name(body.shape) +
+                     "body '" + body.name + "' has shape " + shape_name(body.shape) +
                          "; a 2D scene takes only box (a rectangle) and sphere (a disk)");
   for (int a = 0; a < dim; ++a)
     if (!(body.scale[a] != 0) || !std::isfinite(body.scale[a]))
@@ -212,6 +229,25 @@ void check_body_shape(const BodySpec& body, const Scene& scene) {
             body_where(scene, body, "radius"),
             "the radius must be a positive length in m (got " + format_g6(body.radius) + ")");
       break;
+    case ShapeKind::Ogive: {
+      if (!(body.radius > 0) || !std::isfinite(body.radius))
+        throw InputError(body_where(scene, body, "diameter"),
+                         "the shank's diameter must be a positive length in m (got " +
+                             format_g6(2 * body.radius) + ")");
+      if (!(body.crh >= 0.5) || !std::isfinite(body.crh))
+        throw InputError(body_where(scene, body, "crh"),
+                         "the nose's arc radius must be at least half a diameter (0.5: a "
+                         "hemispherical nose; got " +
+                             format_g6(body.crh) + ")");
+      const double nose = Ogive::nose_length(body.radius, body.crh);
+      if (!(body.length >= nose) || !std::isfinite(body.length))
+        throw InputError(body_where(scene, body, "length"),
+                         "the ogive's overall length must be at least its nose's, " +
+                             format_g6(nose * 1e3) + " mm for crh " + format_g6(body.crh) +
+                             " and diameter " + format_g6(2e3 * body.radius) + " mm (got " +
+                             format_g6(body.length * 1e3) + " mm)");
+      break;
+    }
     case ShapeKind::Mesh:
       break;  // checked when the file is read
   }

@@ -32,6 +32,8 @@ const std::vector<std::string_view> kBodyKeys = {"name",
                                                  "size",
                                                  "radius",
                                                  "length",
+                                                 "diameter",
+                                                 "crh",
                                                  "file",
                                                  "scale",
                                                  "rotate",
@@ -73,10 +75,11 @@ void read_shape(Reader& r, const Scene& scene, BodySpec& b) {
   const auto shape = r.choice<ShapeKind>("shape", {{"box", ShapeKind::Box},
                                                    {"cylinder", ShapeKind::Cylinder},
                                                    {"sphere", ShapeKind::Sphere},
+                                                   {"ogive", ShapeKind::Ogive},
                                                    {"mesh", ShapeKind::Mesh}});
-  if (!shape) r.missing("shape", "one of \"box\", \"cylinder\", \"sphere\", \"mesh\"");
+  if (!shape) r.missing("shape", "one of \"box\", \"cylinder\", \"sphere\", \"ogive\", \"mesh\"");
   b.shape = *shape;
-  if (two_d && (b.shape == ShapeKind::Cylinder || b.shape == ShapeKind::Mesh)) {
+  if (two_d && b.shape != ShapeKind::Box && b.shape != ShapeKind::Sphere) {
     r.fail("shape", "shape \"" + *r.string("shape") +
                         "\" is not available in 2D scenes; use box or sphere (a disk)");
   }
@@ -93,7 +96,7 @@ void read_shape(Reader& r, const Scene& scene, BodySpec& b) {
                                 : "edge lengths x y z, e.g. \"10 10 5 mm\"");
       }
       r.reject({"radius"}, not_for("cylinder and sphere"));
-      r.reject({"length"}, not_for("cylinder"));
+      r.reject({"length"}, not_for("cylinder and ogive"));
       r.reject({"file"}, not_for("mesh"));
       break;
     case ShapeKind::Cylinder:
@@ -102,10 +105,21 @@ void read_shape(Reader& r, const Scene& scene, BodySpec& b) {
       r.reject({"size"}, not_for("box"));
       r.reject({"file"}, not_for("mesh"));
       break;
+    case ShapeKind::Ogive:
+      b.radius = 0.5 * r.required("diameter", dim::length, Bound::Positive, "12.9 mm",
+                                  "the shank's diameter");
+      b.length = r.required("length", dim::length, Bound::Positive, "88.9 mm",
+                            "overall, from the base to the nose tip");
+      b.crh = r.required("crh", dim::none, Bound::Positive, "3.0",
+                         "the nose's arc radius in shank diameters, at least 0.5");
+      r.reject({"size"}, not_for("box"));
+      r.reject({"radius"}, not_for("cylinder and sphere"));
+      r.reject({"file"}, not_for("mesh"));
+      break;
     case ShapeKind::Sphere:
       b.radius = r.required("radius", dim::length, Bound::Positive, "3.8 mm");
       r.reject({"size"}, not_for("box"));
-      r.reject({"length"}, not_for("cylinder"));
+      r.reject({"length"}, not_for("cylinder and ogive"));
       r.reject({"file"}, not_for("mesh"));
       break;
     case ShapeKind::Mesh: {
@@ -118,10 +132,11 @@ void read_shape(Reader& r, const Scene& scene, BodySpec& b) {
                         : (std::filesystem::path(scene.directory) / p).string();
       r.reject({"size"}, not_for("box"));
       r.reject({"radius"}, not_for("cylinder and sphere"));
-      r.reject({"length"}, not_for("cylinder"));
+      r.reject({"length"}, not_for("cylinder and ogive"));
       break;
     }
   }
+  if (b.shape != ShapeKind::Ogive) r.reject({"diameter", "crh"}, not_for("ogive"));
 }
 
 /// Scale, rotation, translation and velocity.

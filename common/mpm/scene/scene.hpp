@@ -84,7 +84,7 @@ struct MaterialSpec {
   double bulk_modulus() const { return youngs_modulus / (3 * (1 - 2 * poisson_ratio)); }
 };
 
-enum class ShapeKind { Box, Cylinder, Sphere, Mesh };
+enum class ShapeKind { Box, Cylinder, Sphere, Mesh, Ogive };
 
 /// A formula of position written in the scene (a body's velocity_field or stress_field), SI.
 /// Its variables are field_variables(); "0" stands for an absent component.
@@ -99,15 +99,17 @@ const std::vector<std::string>& field_variables();
 
 /// A body: a shape in its local frame, placed by scale, then rotation, then translation.
 /// Local frames: box centred on the origin; cylinder along +z from z = 0 to z = length,
-/// axis through the origin; sphere centred on the origin; mesh as in its file.
+/// axis through the origin; ogive (a shank and a tangent-ogive nose) along +z from its base at
+/// z = 0 to its nose tip at z = length; sphere centred on the origin; mesh as in its file.
 /// In 2D scenes the shapes live in the x-y plane: box is a rectangle, sphere a disk.
 struct BodySpec {
   std::string name;
   int material = -1;  ///< index into Scene::materials
   ShapeKind shape = ShapeKind::Box;
   Vec3 size = Vec3::Zero();        ///< box edge lengths, m
-  double radius = 0;               ///< cylinder or sphere, m
-  double length = 0;               ///< cylinder, m
+  double radius = 0;               ///< cylinder or sphere, m; ogive: the shank's radius
+  double length = 0;               ///< cylinder, m; ogive: overall, base to nose tip
+  double crh = 0;                  ///< ogive: the nose's arc radius in shank diameters
   std::string mesh_path;           ///< STL, OFF or OBJ; relative paths are from the scene file
   Vec3 scale = Vec3::Ones();       ///< applied first
   Vec3 rotate_deg = Vec3::Zero();  ///< rotations about x, then y, then z, degrees
