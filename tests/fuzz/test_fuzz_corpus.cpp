@@ -69,5 +69,37 @@ TEST(FuzzCorpus, FormulasCompileOrGiveAnExpressionError) {
   EXPECT_GE(refused, 2);
 }
 
+// ---------------------------------------------------------------------------------------------
+// What the fuzzers (and the review of the readers for them) found, each fed to its entry point.
+
+/// A stream header (format 1.3) and one record header, then `payload` and nothing more.
+std::string stream_with(const char type[4], std::uint64_t length, const std::string& payload) {
+  std::string b("\x89MPM\r\n\x1a\n\x01\x00\x03\x00\x00\x00\x00\x00", 16);
+  b.append(type, 4);
+  b.append(reinterpret_cast<const char*>(&length), 8);
+  return b + payload;
+}
+template <class T>
+std::string le(T v) {
+  return std::string(reinterpret_cast<const char*>(&v), sizeof v);
+}
+
+// A frame whose header claims 2^30 particles of one f64 column, its length agreeing, in a file
+// of 80 bytes: the reader allocated (and zeroed) 8 GB before finding the file cut. Now a file
+// is checked for the bytes its frame needs before anything is allocated.
+TEST(FuzzFindings, FrameClaimingMoreParticlesThanTheFileHoldsIsATruncation) {
+  const std::uint64_t n = std::uint64_t(1) << 30;
+  std::string table = le<std::int64_t>(0) + le<double>(0) + le<std::uint32_t>(0) + le(n) +
+                      le<std::uint32_t>(1) + le<std::uint16_t>(1) + "x" + le<std::uint8_t>(1) +
+                      le<std::uint8_t>(1) + le<std::uint16_t>(0);
+  const std::string b = stream_with("FRAM", table.size() + 8 * n, table);
+  const std::string message = feed(stream, b);
+  EXPECT_NE(message.find("stream truncated in record 1 (FRAM at byte 16): expected " +
+                         std::to_string(table.size() + 8 * n) + " payload bytes, found " +
+                         std::to_string(table.size())),
+            std::string::npos)
+      << message;
+}
+
 }  // namespace
 }  // namespace mpm::fuzz
