@@ -6,13 +6,15 @@
 
 BUILD ?= build
 JOBS ?= $(shell nproc)
+# Sanitizer and fuzzer builds are heavy: at most two jobs.
+FUZZ_JOBS ?= 2
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
 DEB_PACKAGES = build-essential cmake pkg-config libeigen3-dev libcgal-dev libvtk9-dev \
   libcli11-dev libgtest-dev googletest libtomlplusplus-dev zlib1g-dev xvfb xauth hyperfine \
   gnuplot-nox python3 bc clang-format ccache libmuparser-dev
 
-.PHONY: all deps build demo test test-long bench clean format layout
+.PHONY: all deps build demo test test-long bench clean format layout test-asan fuzz
 
 all: build
 
@@ -45,6 +47,39 @@ test: build
 
 test-long: build
 	cd $(BUILD) && ctest -L long --output-on-failure
+
+# The default test set under AddressSanitizer and UndefinedBehaviorSanitizer (gcc, -O1 -g,
+# OpenMP on, asserts on) in build-asan; any report fails the test that caused it.
+ASAN_BUILD ?= build-asan
+SAN_ENV = ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:strict_string_checks=1 \
+  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 LSAN_OPTIONS=suppressions=$(abspath tests/tools/lsan.supp)
+test-asan: deps
+	cmake -S . -B $(ASAN_BUILD) $(filter-out -DCMAKE_BUILD_TYPE=%,$(CMAKE_FLAGS)) \
+	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+	  -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g" -DMPM_SANITIZE=address,undefined
+	nice -n 10 cmake --build $(ASAN_BUILD) -j$(FUZZ_JOBS)
+	cd $(ASAN_BUILD) && $(SAN_ENV) OMP_WAIT_POLICY=passive \
+	  ctest -LE long --output-on-failure -j$(FUZZ_JOBS) --timeout 1800
+
+# The libFuzzer harnesses of tests/fuzz (clang, -fsanitize=fuzzer,address,undefined) in
+# build-fuzz, each run for FUZZ_SECONDS over its seed corpus (tests/fuzz/corpus/<name>) and the
+# inputs it found before (build-fuzz/corpus/<name>). Crashes, hangs (-timeout) and
+# out-of-memory inputs (-rss_limit_mb) land in build-fuzz/crashes/<name>/ and stop the target.
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZERS ?= scene mesh stream expression
+fuzz: deps
+	cmake -S . -B $(FUZZ_BUILD) $(filter-out -DCMAKE_BUILD_TYPE=%,$(CMAKE_FLAGS)) -DMPM_FUZZ=ON \
+	  -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g"
+	nice -n 10 cmake --build $(FUZZ_BUILD) -j$(FUZZ_JOBS)
+	for f in $(FUZZERS); do \
+	  mkdir -p $(FUZZ_BUILD)/corpus/$$f $(FUZZ_BUILD)/crashes/$$f && \
+	  OMP_WAIT_POLICY=passive OMP_NUM_THREADS=1 nice -n 10 $(FUZZ_BUILD)/fuzz_$$f \
+	    $(FUZZ_BUILD)/corpus/$$f tests/fuzz/corpus/$$f -dict=tests/fuzz/$$f.dict \
+	    -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=2048 -max_len=8192 \
+	    -artifact_prefix=$(FUZZ_BUILD)/crashes/$$f/ -print_final_stats=1 || exit 1; \
+	done
 
 bench: build
 	$(MAKE) -C bench BIN=$(abspath $(BUILD))

@@ -1068,7 +1068,23 @@ TEST_F(VoxeliseMesh, BadMeshesAreRefusedNamingTheFile) {
   s.bodies = {mesh_body("lid", kData + "open_cube.stl", 17)};
   std::string msg = input_error_of([&] { run(s); });
   EXPECT_NE(msg.find("scene.toml:17: bodies.lid.file"), std::string::npos) << msg;
-  EXPECT_NE(msg.find("open_cube.stl' is not closed: 4 border edges; close it or use a primitive"),
+  // The hole is named by where it is: the cube's missing face at z = -0.5.
+  EXPECT_NE(msg.find("open_cube.stl' is not closed: 4 border edges around 1 hole: 4 edges around "
+                     "(0, 0, -0.5) in the file's coordinates; close it or use a primitive"),
+            std::string::npos)
+      << msg;
+
+  // A box without its two z faces, placed at 1/1000 of its size elsewhere: two holes, each
+  // named in the file's own coordinates (placement undone), where a user would look for it.
+  TriMesh tube = box_mesh(Vec3(2, 2, 2));
+  tube.f.erase(tube.f.begin(), tube.f.begin() + 4);
+  tube.write_off(dir_ / "tube.off");
+  s.bodies = {mesh_body("tube", (dir_ / "tube.off").string(), 17)};
+  s.bodies[0].scale = Vec3::Constant(1e-3);
+  s.bodies[0].translate = Vec3(0.5, 0, 0);
+  msg = input_error_of([&] { run(s); });
+  EXPECT_NE(msg.find("tube.off' is not closed: 8 border edges around 2 holes: 4 edges around "
+                     "(0, 0, -1); 4 edges around (0, 0, 1) in the file's coordinates"),
             std::string::npos)
       << msg;
 

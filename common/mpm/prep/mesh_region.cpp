@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "mpm/core/error.hpp"
+#include "mpm/core/units.hpp"
 #include "mpm/prep/body_placement.hpp"
 
 // Several OpenMP threads query one AABB tree. CGAL guards its lazily built structures only
@@ -143,6 +144,42 @@ void mesh_box(const Mesh& mesh, Vec3& lo, Vec3& hi) {
   }
 }
 
+/// "4 border edges around 1 hole: 4 edges around (x, y, z) ... in the file's coordinates":
+/// the holes of a mesh (cycles of border edges), each by its edge count and the centre of its
+/// vertices in the file's coordinates (the placement undone), the first three of them; empty
+/// when the mesh is closed.
+std::string describe_holes(const Mesh& mesh, const BodySpec& body) {
+  std::size_t border = 0;
+  for (auto h : mesh.halfedges())
+    if (mesh.is_border(h)) ++border;
+  if (border == 0) return "";
+  const Mat3 A = body_linear_map(body);
+  const bool invertible = std::abs(A.determinant()) > 0;
+  std::vector<bool> seen(mesh.number_of_halfedges(), false);
+  std::size_t holes = 0;
+  std::string where;
+  for (auto h : mesh.halfedges()) {
+    if (!mesh.is_border(h) || seen[h.idx()]) continue;
+    ++holes;
+    Vec3 c = Vec3::Zero();
+    std::size_t edges = 0;
+    for (auto g : CGAL::halfedges_around_face(h, mesh)) {
+      seen[g.idx()] = true;
+      const Point& p = mesh.point(mesh.target(g));
+      c += Vec3(p.x(), p.y(), p.z());
+      ++edges;
+    }
+    c /= double(edges);
+    if (invertible) c = A.inverse() * (c - body.translate);
+    if (holes <= 3)
+      where += std::string(holes > 1 ? "; " : "") + std::to_string(edges) + " edges around (" +
+               format_g6(c.x()) + ", " + format_g6(c.y()) + ", " + format_g6(c.z()) + ")";
+  }
+  return std::to_string(border) + " border edges around " + std::to_string(holes) +
+         (holes == 1 ? " hole: " : " holes: ") + where + (holes > 3 ? "; ..." : "") +
+         " in the file's coordinates";
+}
+
 }  // namespace
 
 struct MeshRegion::Impl {
@@ -159,12 +196,9 @@ MeshRegion::MeshRegion(const BodySpec& body, const Scene& scene) : impl_(std::ma
   Mesh& mesh = impl_->mesh;
   mesh = read_placed_mesh(body, scene);
 
-  std::size_t border = 0;
-  for (auto h : mesh.halfedges())
-    if (mesh.is_border(h)) ++border;
-  if (border > 0)
-    throw InputError(at, "mesh " + name + " is not closed: " + std::to_string(border) +
-                             " border edges; close it or use a primitive");
+  if (const std::string holes = describe_holes(mesh, body); !holes.empty())
+    throw InputError(at,
+                     "mesh " + name + " is not closed: " + holes + "; close it or use a primitive");
   std::size_t degenerate = 0;
   for (auto f : mesh.faces())
     if (PMP::is_degenerate_triangle_face(f, mesh)) ++degenerate;

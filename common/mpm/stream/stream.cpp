@@ -1,5 +1,6 @@
 #include "mpm/stream/stream.hpp"
 
+#include <sys/stat.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -7,6 +8,7 @@
 #include <cerrno>
 #include <cstring>
 #include <limits>
+#include <new>
 #include <stdexcept>
 
 #include "mpm/core/error.hpp"
@@ -586,8 +588,20 @@ Frame StreamReader::read_frame_body() {
     fail_corrupt("its length " + std::to_string(length_) + " disagrees with its column table (" +
                  std::to_string(done_ + data_bytes) + " bytes)");
 
+  // A corrupted count must not allocate more than the stream holds: a file says how many bytes
+  // are left (a pipe does not; there an impossible allocation is refused as corruption).
+  struct stat st;
+  if (fstat(fileno(f_), &st) == 0 && S_ISREG(st.st_mode) && data_bytes > 0) {
+    const std::uint64_t left = std::uint64_t(st.st_size) > offset_ ? st.st_size - offset_ : 0;
+    if (data_bytes > left) fail_truncated(std::to_string(length_) + " payload bytes", done_ + left);
+  }
   for (const In& c : cols) frame.columns.add(c.info);
-  frame.columns.resize(n);
+  try {
+    frame.columns.resize(n);
+  } catch (const std::bad_alloc&) {
+    fail_corrupt("its " + std::to_string(n) + " particles need " + std::to_string(data_bytes) +
+                 " bytes, more than can be allocated");
+  }
   std::vector<float> buf;
   for (const In& c : cols) {
     Column& col = frame.columns.at(c.info.name);
