@@ -64,6 +64,24 @@ std::vector<std::uint8_t> rigid_body_held(const Scene& scene) {
   return held;
 }
 
+/// The marks rigid bodies leave on the nodes they touch (the grid's u8 column `rigid`): by
+/// body, 1 + its rank among the rigid bodies (0 for deformable bodies); `marked` lists the
+/// rigid bodies by mark - 1. Throws InputError past 255 rigid bodies.
+inline void rigid_body_marks(const Scene& scene, std::vector<std::uint8_t>& mark,
+                             std::vector<std::uint32_t>& marked) {
+  mark.assign(scene.bodies.size(), 0);
+  marked.clear();
+  for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+    if (!scene.bodies[b].rigid) continue;
+    if (marked.size() == 255)
+      throw InputError(
+          where(scene.source, scene.bodies[b].loc.line, "bodies." + scene.bodies[b].name),
+          "a scene holds at most 255 rigid bodies");
+    marked.push_back(std::uint32_t(b));
+    mark[b] = std::uint8_t(marked.size());
+  }
+}
+
 /// Checks that every particle starts inside the grid's domain (InputError naming the first
 /// that does not) and returns the nodal-mass floor below which a node counts as empty: 1e-14
 /// of the lightest deformable particle.
@@ -199,6 +217,8 @@ class SolverCore {
   std::vector<Vec<D>> rigid_velocity_;    ///< by body; zero for deformable bodies
   std::vector<std::uint8_t> rigid_held_;  ///< by body: the components it imposes (bits)
   std::vector<Vec3> rigid_force_;
+  std::vector<std::uint8_t> rigid_mark_;    ///< by body: its mark on the nodes (rigid_body_marks)
+  std::vector<std::uint32_t> marked_body_;  ///< by mark - 1: the rigid body
   Vec<D> gravity_ = Vec<D>::Zero();
   double dt_ = 0, time_ = 0;  ///< s: the step being taken, the time reached
   long steps_ = 0;
@@ -233,6 +253,7 @@ SolverCore<GridT>::SolverCore(const Scene& scene, GridT grid, ColumnStore& parti
   for (int a = 0; a < D; ++a) gravity_[a] = scene_.solver.gravity[a];
   has_rigid_ = rigid_body_velocities<D>(scene_, rigid_velocity_);
   rigid_held_ = rigid_body_held<D>(scene_);
+  rigid_body_marks(scene_, rigid_mark_, marked_body_);
   rigid_force_.assign(scene_.bodies.size(), Vec3::Zero());
   scratch_.resize(omp_get_max_threads());
   for (auto& s : scratch_) s = std::make_unique<StressScratch>();
