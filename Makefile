@@ -3,6 +3,8 @@
 #   make test   installs what is missing, builds, runs the tests (all but the long studies)
 #   make bench  the V3 Taylor bar throughput benchmark (particle-steps per second, memory)
 #   make test-long   the long studies (minutes to hours)
+#   make study  the trade of accuracy against cost and the extremes map (examples/trade,
+#               examples/extremes; about 10 minutes of CPU, one thread)
 
 BUILD ?= build
 JOBS ?= $(shell nproc)
@@ -14,7 +16,7 @@ DEB_PACKAGES = build-essential cmake pkg-config libeigen3-dev libcgal-dev libvtk
   libcli11-dev libgtest-dev googletest libtomlplusplus-dev zlib1g-dev xvfb xauth hyperfine \
   gnuplot-nox python3 bc clang-format ccache libmuparser-dev
 
-.PHONY: all deps build demo test test-long bench clean format layout test-asan fuzz
+.PHONY: all deps build demo test test-long bench study clean format layout test-asan fuzz
 
 all: build
 
@@ -83,6 +85,10 @@ fuzz: deps
 
 bench: build
 	$(MAKE) -C bench BIN=$(abspath $(BUILD))
+
+study: build
+	$(MAKE) -C examples/trade study BIN=$(abspath $(BUILD))
+	$(MAKE) -C examples/extremes study BIN=$(abspath $(BUILD))
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')

@@ -8,6 +8,7 @@
 #include "mpm/core/error.hpp"
 #include "mpm/core/version.hpp"
 #include "mpm/prep/prep.hpp"
+#include "mpm/prep/target_error.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -26,6 +27,11 @@ int main(int argc, char** argv) {
   app.add_option("--max-memory", max_memory,
                  "refuse a model that would need more memory (e.g. 16G; K, M, G, T are powers "
                  "of 1024); default: the machine's memory");
+  std::string target_error;
+  app.add_option("--target-error", target_error,
+                 "Taylor bars like V2 only: the cheapest cell size and particles per cell whose "
+                 "error against the experiment the trade study's fit puts within this "
+                 "percentage (e.g. 2%); the model is made with them (examples/trade)");
   app.set_version_flag("--version", std::string("mpm-prep ") + mpm::kVersion);
   try {
     app.parse(argc, argv);
@@ -44,6 +50,7 @@ int main(int argc, char** argv) {
     mpm::refuse_terminal_output(opt.output, "the model stream");
     mpm::check_output_file(opt.output, {opt.scene});
     if (!max_memory.empty()) opt.max_memory = mpm::parse_memory_size(max_memory, "--max-memory");
+    if (!target_error.empty()) opt.target_error = mpm::parse_target_error(target_error);
     return mpm::prepare_model(opt);
   });
 }

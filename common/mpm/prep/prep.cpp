@@ -19,6 +19,8 @@
 #include "mpm/prep/initial_fields.hpp"
 #include "mpm/prep/region.hpp"
 #include "mpm/prep/resources.hpp"
+#include "mpm/prep/scene_needs.hpp"
+#include "mpm/prep/target_error.hpp"
 #include "mpm/prep/voxelise.hpp"
 #include "mpm/scene/particles.hpp"
 #include "mpm/solver/materials/material.hpp"
@@ -307,6 +309,11 @@ VoxeliseCells progress_cells(const Scene& scene) {
 int prepare_model(const PrepOptions& opt) {
   const double t0 = omp_get_wtime();
   Scene scene = load_scene(opt.scene, opt.overrides);
+  std::optional<TargetProposal> proposal;  // --target-error: the scene with the proposed cells
+  if (opt.target_error > 0) {
+    proposal = propose_for_target(scene, opt.target_error);
+    scene = parse_scene(scene.toml, scene.source, scene.directory, proposal->overrides);
+  }
   std::vector<std::string> warnings = scene.warnings;
   const BodyBoxes boxes = body_boxes(scene);
   check_mesh_sizes(scene, boxes, warnings);
@@ -329,6 +336,9 @@ int prepare_model(const PrepOptions& opt) {
     const std::size_t total = print_bodies(scene, report);
     print_materials(scene, graded_grid ? graded_grid->h_min : lattice.h);
     print_estimates(scene, estimates, total);
+    if (proposal) print_proposal(*proposal, double(total) * estimates.steps);
+    for (const std::string& s : scene_needs(scene, lattice, cols, report))
+      std::fprintf(stderr, "  %s\n", s.c_str());
   }
   warnings.clear();
   overlap_warnings(scene, report, warnings);

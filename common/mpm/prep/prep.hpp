@@ -12,6 +12,9 @@ struct PrepOptions {
   std::vector<std::string> overrides;  ///< --set key=value
   bool quiet = false;                  ///< no summary on stderr
   double max_memory = 0;  ///< bytes a model may need (--max-memory); 0: the machine's memory
+  /// --target-error as a fraction (0.02 for 2%): the scene's cell size and particles per cell
+  /// are replaced by the cheapest that the trade study's fit says reach it; 0: as the scene says
+  double target_error = 0;
 };
 
 /// Builds the model and writes it. Returns the exit status; throws InputError for bad input.
