@@ -32,11 +32,15 @@ namespace mpm {
 /// A run that went unstable: the step, the particle (its id) and the cause.
 class InstabilityError : public std::runtime_error {
  public:
-  InstabilityError(long step, double time, long particle, const std::string& cause);
+  /// left_domain: the run stopped because a particle left the domain (solver.on_exit =
+  /// "stop"), which is not an instability: the message says "stopped", the exit status is 5.
+  InstabilityError(long step, double time, long particle, const std::string& cause,
+                   bool left_domain = false);
   long step;
   double time;
   long particle;  ///< particle id, -1 when the cause is global (energy growth)
   std::string cause;
+  bool left_domain;
 };
 
 /// Prescribed velocities of the scene's rigid bodies, by body (zero for deformable bodies);
@@ -376,7 +380,8 @@ void SolverCore<GridT>::reduce(const std::vector<ChunkSums>& chunks, ChunkSums& 
     total.out_of_window = total.out_of_window || s.out_of_window;
     for (auto i : s.exits) {
       if (scene_.solver.on_exit == OnExit::Stop)
-        throw InstabilityError(steps_ + 1, time_ + dt_, p.id[i], exit_message(p.x[i].data(), D));
+        throw InstabilityError(steps_ + 1, time_ + dt_, p.id[i], exit_message(p.x[i].data(), D),
+                               true);
       exits_.push_back(i);
     }
   }
