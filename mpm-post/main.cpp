@@ -79,9 +79,9 @@ CLI::App* add_taylor(CLI::App& app, mpm::TaylorArgs& a) {
   sub->add_option(
       "--wall", a.wall,
       "wall position along the axis, e.g. \"0 mm\" (default: the constrained domain face)");
-  sub->add_flag(
-      "--surface", a.surface,
-      "measure the surface (centres + half a particle spacing) instead of particle centres");
+  sub->add_flag("--surface", a.surface,
+                "measure the surface (centres + half a particle spacing; on a graded grid the "
+                "spacing of the level the end and the foot lie on) instead of particle centres");
   sub->add_option("--expect-L", a.expect_L,
                   "reference length, e.g. \"16.2 mm\", to print the difference");
   sub->add_option("--expect-D", a.expect_D, "reference diameter, e.g. \"13.5 mm\"");

@@ -306,7 +306,8 @@ def measure(bin_dir, result, bound, limit=0.05):
     """Energy error (of leapfrog_total against its start, over the guard's scale), finite
     frames, the largest particle speed of the last frame against the problem's bound."""
     hist = post(bin_dir, ["history", result])
-    rows = list(csv.DictReader(hist.splitlines())) if hist else []
+    lines = [l for l in hist.splitlines() if not l.startswith("#")] if hist else []
+    rows = list(csv.DictReader(lines))  # "# units: ..." lines are comments
     f = no_figures()
     if rows:
         e0 = float(rows[0]["leapfrog_total"])
@@ -345,7 +346,7 @@ CONTAINED = ("cfl disk", "ppc", "empty hole", "tiny onto wall", "contrast", "cfl
 def verdict(r, f, bound, family, limit=0.05):
     if r["stage"] == "mpm-prep" or r["status"] == 2:
         return "refused" if r["status"] == 2 else "CRASH"
-    if r["status"] == 3:
+    if r["status"] in (3, 5):  # 5: a particle left the domain with on_exit = "stop"
         return "stopped"
     if r["status"] != 0:
         return "CRASH"

@@ -148,17 +148,14 @@ def post(bin_dir, args):
                           capture_output=True, text=True).stdout
 
 
-def taylor_error(bin_dir, result, graded=False):
+def taylor_error(bin_dir, result):
     """L and D on the surface (a caliper on the specimen: particle centres plus half a
-    spacing at the free end and at each side of the foot) against the experiment; error = the
-    larger of the two, in %. On the graded grid the foot's particles are the fine level's,
-    half the spacing mpm-post --surface adds (the model's, the coarse level's): D gets the
-    fine spacing instead."""
+    spacing at the free end and at each side of the foot; on a graded grid the spacing of the
+    level each lies on) against the experiment; error = the larger of the two, in %."""
+    s = json.loads(post(bin_dir, ["taylor", result, "--json", "--surface"]))
     c = json.loads(post(bin_dir, ["taylor", result, "--json"]))
-    s = c["spacing"]
-    L, D = c["L"] + s / 2, c["D"] + (s / 2 if graded else s)
-    eL, eD = 100 * (L / L_EXP - 1), 100 * (D / D_EXP - 1)
-    return dict(error_pct=max(abs(eL), abs(eD)), L_mm=L * 1e3, D_mm=D * 1e3,
+    eL, eD = 100 * (s["L"] / L_EXP - 1), 100 * (s["D"] / D_EXP - 1)
+    return dict(error_pct=max(abs(eL), abs(eD)), L_mm=s["L"] * 1e3, D_mm=s["D"] * 1e3,
                 L_err_pct=eL, D_err_pct=eD, L_centres_mm=c["L"] * 1e3, D_centres_mm=c["D"] * 1e3)
 
 
@@ -246,7 +243,7 @@ def main():
                 row["wall_runs_s"] = " ".join(f"{r['wall_s']:.2f}" for r in runs)
                 row["ns_per_particle_step"] = 1e9 * row["cpu_s"] / row["particle_steps"]
                 if problem == "taylor":
-                    row.update(taylor_error(bin_dir, result, knobs["grid"] == "graded"))
+                    row.update(taylor_error(bin_dir, result))
                 else:
                     row.update(rod_error(bin_dir, result, out_dir, tag))
                 os.remove(result)

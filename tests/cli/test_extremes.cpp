@@ -46,7 +46,8 @@ std::pair<double, double> energies(const fs::path& dir) {
   const Result h = run(post + " history " + (dir / "r.mpm").string(), dir);
   std::istringstream in(h.out);
   std::string header, line, first, last;
-  std::getline(in, header);
+  while (std::getline(in, header) && header.rfind("#", 0) == 0) {
+  }  // "# units: ..." comments
   std::getline(in, first);
   last = first;
   while (std::getline(in, line))

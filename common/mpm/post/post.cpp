@@ -22,6 +22,22 @@ TaylorMeter::TaylorMeter(const Scene& scene, const TaylorOptions& options)
   }
 }
 
+double TaylorMeter::local_spacing(const Vec3& x) const {
+  const BodySpec& spec = scene_.bodies[body_];
+  int level = 1;
+  for (const LevelSpec& l : scene_.grid.levels) {
+    if (l.follow >= 0) return spec.spacing(scene_.grid.cell_size);  // boxes moved: unknown
+    for (int k = 0; k < symmetry_.images(); ++k) {  // x may be a mirror image of a particle
+      const Vec3 y = symmetry_.point_image(x, k);
+      bool inside = l.level > level;
+      for (int a = 0; a < scene_.dimension; ++a)
+        inside = inside && y[a] >= l.min[a] && y[a] <= l.max[a];
+      if (inside) level = l.level;
+    }
+  }
+  return spec.spacing(std::ldexp(scene_.grid.cell_size, 1 - level));
+}
+
 TaylorResult TaylorMeter::measure(const Frame& frame) const {
   const int d = scene_.dimension;
   TaylorResult r;
@@ -80,20 +96,25 @@ TaylorResult TaylorMeter::measure(const Frame& frame) const {
   }
 
   double L = 0, R = 0;
-  std::vector<double> u, w;  // the particles' coordinates across the axis (3D)
+  std::size_t i_L = 0, i_R = 0;  // the particles farthest from the wall and from the axis
+  std::vector<double> u, w;      // the particles' coordinates across the axis (3D)
   if (d == 3) u.reserve(x.size()), w.reserve(x.size());
   const int a1 = (ax + 1) % 3, a2 = (ax + 2) % 3;
   const int lat = d == 2 ? 1 - ax : -1;  // 2D: the one coordinate across the axis
-  for (const Vec3& p : x) {
-    L = std::max(L, std::abs(p[ax] - r.wall));
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const Vec3& p = x[i];
+    if (std::abs(p[ax] - r.wall) > L) L = std::abs(p[ax] - r.wall), i_L = i;
     double r2 = 0;
     for (int a = 0; a < d; ++a)
       if (a != ax) r2 += (p[a] - centre[a]) * (p[a] - centre[a]);
-    R = std::max(R, std::sqrt(r2));
+    if (std::sqrt(r2) > R) R = std::sqrt(r2), i_R = i;
     if (d == 3) u.push_back(p[a1]), w.push_back(p[a2]);
   }
-  const double add = opt_.surface ? r.spacing : 0.0;
-  r.L = L + 0.5 * add;
+  // On a graded grid the free end and the foot may lie on different levels: each gets the
+  // spacing of the particles there (a particle in a finer box has split to its spacing).
+  const double add_L = opt_.surface ? local_spacing(x[i_L]) : 0.0;
+  const double add = opt_.surface ? local_spacing(x[i_R]) : 0.0;
+  r.L = L + 0.5 * add_L;
   if (d == 3) {
     const Calipers c = caliper_widths(u, w);
     r.D = c.mean + add, r.D_min = c.min + add, r.D_max = c.max + add;

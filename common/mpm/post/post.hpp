@@ -51,6 +51,9 @@ class TaylorMeter {
   TaylorResult measure(const Frame& frame) const;
 
  private:
+  /// The particle spacing (m) where x lies at the start's levels: the finest level box holding
+  /// x on a graded grid (a particle there split to its spacing), else the body's spacing.
+  double local_spacing(const Vec3& x) const;
   Scene scene_;
   TaylorOptions opt_;
   Symmetry symmetry_;
