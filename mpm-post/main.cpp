@@ -9,6 +9,7 @@
 #include "mpm/core/cli.hpp"
 #include "mpm/core/error.hpp"
 #include "mpm/core/version.hpp"
+#include "mpm/post/command_io.hpp"
 #include "mpm/post/commands.hpp"
 #include "mpm/post/vtk/vtk_commands.hpp"
 
@@ -52,6 +53,14 @@ CLI::App* add_vtk(CLI::App& app, mpm::VtkArgs& a) {
   return sub;
 }
 
+/// The --symmetry option of the measures and render; `what` says what the planes change.
+void add_symmetry(CLI::App* sub, std::string& symmetry, const std::string& what) {
+  sub->add_option("--symmetry", symmetry,
+                  "mirror planes of a quarter or half model, e.g. \"x = 0, y = 0 mm\", or "
+                  "\"none\"" +
+                      what + " (default: the scene's slip faces through a body)");
+}
+
 CLI::App* add_taylor(CLI::App& app, mpm::TaylorArgs& a) {
   auto* sub = app.add_subcommand(
       "taylor", "final length L and foot diameter D (mean caliper width) of a bar against a wall");
@@ -67,6 +76,7 @@ CLI::App* add_taylor(CLI::App& app, mpm::TaylorArgs& a) {
   sub->add_option("--expect-L", a.expect_L,
                   "reference length, e.g. \"16.2 mm\", to print the difference");
   sub->add_option("--expect-D", a.expect_D, "reference diameter, e.g. \"13.5 mm\"");
+  add_symmetry(sub, a.symmetry, "; the measure is the whole body's");
   sub->add_flag("--json", a.json, "print JSON (SI units)");
   return sub;
 }
@@ -81,6 +91,11 @@ CLI::App* add_debris(CLI::App& app, mpm::DebrisArgs& a) {
   sub->add_option(
       "--plane", a.plane,
       "reference plane along the axis, e.g. \"6.36 mm\" (default: the target's rear face)");
+  sub->add_option("--face", a.face,
+                  "the target's face the front is measured from: rear or impact (the cloud is "
+                  "what lies behind the rear face either way)")
+      ->check(CLI::IsMember({"rear", "impact"}))
+      ->capture_default_str();
   sub->add_option("--target", a.target, "target body (default: the first body at rest)");
   sub->add_option("--projectile", a.projectile, "projectile body (default: the fastest body)");
   sub->add_option(
@@ -97,8 +112,30 @@ CLI::App* add_debris(CLI::App& app, mpm::DebrisArgs& a) {
       ->capture_default_str();
   sub->add_option("--link", a.link,
                   "linking length of fragments, e.g. \"1 mm\" (default: the grid's cell size)");
+  sub->add_flag("--escaped", a.escaped,
+                "also count the particles that left the domain by the frame's time (the run's "
+                "escape records), and those of them that left behind the plane");
   sub->add_option("--expect-front", a.expect_front, "reference front, e.g. \"200 mm\"");
   sub->add_option("--expect-width", a.expect_width, "reference width, e.g. \"145 mm\"");
+  add_symmetry(sub, a.symmetry, "; the measure is the whole body's");
+  sub->add_flag("--json", a.json, "print JSON (SI units)");
+  return sub;
+}
+
+CLI::App* add_crater(CLI::App& app, mpm::CraterArgs& a) {
+  auto* sub = app.add_subcommand(
+      "crater",
+      "depth and diameter of a target's crater (or the hole when perforated) on the impact "
+      "axis, and how deep each body went");
+  sub->add_option("input", a.input, "stream, - for stdin")->capture_default_str();
+  sub->add_option("--time", a.time,
+                  "the frame nearest this time, e.g. \"40 us\" (default: the last)");
+  sub->add_option("--target", a.target, "target body (default: the first body at rest)");
+  sub->add_option("--projectile", a.projectile,
+                  "projectile body: the crater's axis runs through its initial centre (default: "
+                  "the fastest body)");
+  sub->add_option("--axis", a.axis, "impact axis x, y or z (default: the projectile's velocity)");
+  add_symmetry(sub, a.symmetry, "");
   sub->add_flag("--json", a.json, "print JSON (SI units)");
   return sub;
 }
@@ -127,6 +164,11 @@ CLI::App* add_profile(CLI::App& app, mpm::ProfileArgs& a) {
   sub->add_option("--body", a.body, "only this body's particles");
   sub->add_option("--bins", a.profile.bins,
                   "average in this many equal bins along the line (default: one row per particle)");
+  sub->add_option("--weight", a.weight,
+                  "what a particle weighs in a bin's mean (and the weight column): volume "
+                  "(m/rho: a mean over space) or mass (m: a mean over material); --grid: mass")
+      ->check(CLI::IsMember({"volume", "mass"}))
+      ->capture_default_str();
   sub->add_flag("--grid", a.grid,
                 "on the grid: project the field onto the run's grid nodes (linear shape "
                 "functions, mass-weighted) and profile the nodes near the line");
@@ -149,11 +191,20 @@ CLI::App* add_render(CLI::App& app, mpm::RenderArgs& a) {
       ->capture_default_str();
   sub->add_option("--component", a.picture.component,
                   "component of a vector field (-1: magnitude)");
-  sub->add_option("--view", a.picture.view, "side, front, top or iso")
-      ->check(CLI::IsMember({"side", "front", "top", "iso"}))
+  sub->add_option("--view", a.picture.view,
+                  "orthographic view: side (looking along -y), front (-x), top (-z), iso (from "
+                  "+x+y+z), or symmetry (square on to a mirror plane of a quarter or half model: "
+                  "the section of the whole body there, e.g. through a crater)")
+      ->check(CLI::IsMember({"side", "front", "top", "iso", "symmetry"}))
       ->capture_default_str();
+  sub->add_option("--section", a.picture.section,
+                  "cut at a plane in absolute coordinates, e.g. \"x = 0\" or \"y = 2.5 mm\" "
+                  "(plain numbers in m): keeps the side with more particles and looks square at "
+                  "the cut");
+  add_symmetry(sub, a.symmetry, "; the picture shows the whole body");
   sub->add_option("--clip", a.picture.clip,
-                  "keep one side of a plane through the centroid, e.g. \"y>0\"");
+                  "keep one side of a plane given as an OFFSET FROM THE MODEL'S CENTROID, e.g. "
+                  "\"y>0\" (the centroid's side), \"y>2mm\"; for absolute planes use --section");
   sub->add_option("--size", a.size, "WIDTHxHEIGHT in pixels")->capture_default_str();
   sub->add_option("--range", a.range, "colour range MIN:MAX (SI units)");
   sub->add_option("--title", a.picture.title, "title text");
@@ -184,6 +235,7 @@ int main(int argc, char** argv) {
   mpm::TaylorArgs taylor_args;
   mpm::DebrisArgs debris_args;
   mpm::ProfileArgs profile_args;
+  mpm::CraterArgs crater_args;
   mpm::RenderArgs render_args;
   const auto* summary = add_summary(app, summary_args);
   const auto* history = add_history(app, history_args);
@@ -192,6 +244,7 @@ int main(int argc, char** argv) {
   const auto* taylor = add_taylor(app, taylor_args);
   const auto* debris = add_debris(app, debris_args);
   const auto* profile = add_profile(app, profile_args);
+  const auto* crater = add_crater(app, crater_args);
   const auto* render = add_render(app, render_args);
   try {
     app.parse(argc, argv);
@@ -206,6 +259,13 @@ int main(int argc, char** argv) {
     if (*particles) mpm::check_output_file(particles_args.output, {particles_args.input});
     if (*profile) mpm::check_output_file(profile_args.output, {profile_args.input});
     if (*render) mpm::check_output_file(render_args.output, {render_args.input});
+    // Measures need a result: a model from mpm-prep is refused, naming what to run.
+    if (*history) mpm::require_result(history_args.input, "history");
+    if (*taylor) mpm::require_result(taylor_args.input, "taylor");
+    if (*debris) mpm::require_result(debris_args.input, "debris");
+    if (*crater) mpm::require_result(crater_args.input, "crater");
+    if (*profile) mpm::require_result(profile_args.input, "profile");
+    if (*render) mpm::require_result(render_args.input, "render");
     if (*summary) return mpm::post_summary(summary_args);
     if (*history) return mpm::post_history(history_args);
     if (*particles) return mpm::post_particles(particles_args);
@@ -213,6 +273,7 @@ int main(int argc, char** argv) {
     if (*taylor) return mpm::post_taylor(taylor_args);
     if (*debris) return mpm::post_debris(debris_args);
     if (*profile) return mpm::post_profile(profile_args);
+    if (*crater) return mpm::post_crater(crater_args);
     if (*render) {
       mpm::ensure_display(argc, argv);  // before reading: a re-run under xvfb reads stdin again
       return mpm::post_render(render_args);

@@ -2,6 +2,7 @@
 //   mpm-prep examples/taylor-bar/scene.toml -o taylor.model
 //   mpm-prep scene.toml --set grid.cell_size="0.38 mm" | mpm-run | mpm-post taylor -
 #include <CLI/CLI.hpp>
+#include <cstdio>
 
 #include "mpm/core/cli.hpp"
 #include "mpm/core/error.hpp"
@@ -21,17 +22,28 @@ int main(int argc, char** argv) {
                  "override a scene value, KEY=VALUE (e.g. grid.cell_size=0.38mm); repeatable")
       ->allow_extra_args(false);
   app.add_flag("-q,--quiet", opt.quiet, "no summary on stderr");
+  std::string max_memory;
+  app.add_option("--max-memory", max_memory,
+                 "refuse a model that would need more memory (e.g. 16G; K, M, G, T are powers "
+                 "of 1024); default: the machine's memory");
   app.set_version_flag("--version", std::string("mpm-prep ") + mpm::kVersion);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
+    // "--set bodies.bar.velocity=0 0 -190 m/s" unquoted: the shell split the value.
+    if (dynamic_cast<const CLI::ExtrasError*>(&e))
+      std::fprintf(stderr,
+                   "a --set value with spaces must be quoted for the shell: --set "
+                   "'bodies.bar.velocity=0 0 -190 m/s' or --set bodies.bar.velocity=\"0 0 -190 "
+                   "m/s\"\n");
     return code == 0 ? 0 : mpm::kExitBadInput;
   }
   return mpm::guarded_main("mpm-prep", [&] {
     mpm::ignore_sigpipe();
     mpm::refuse_terminal_output(opt.output, "the model stream");
     mpm::check_output_file(opt.output, {opt.scene});
+    if (!max_memory.empty()) opt.max_memory = mpm::parse_memory_size(max_memory, "--max-memory");
     return mpm::prepare_model(opt);
   });
 }

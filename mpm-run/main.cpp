@@ -1,6 +1,7 @@
 // mpm-run: the solver. Reads a model stream (from mpm-prep), writes a result stream.
 //   mpm-prep scene.toml | mpm-run --threads 2 --stats | mpm-post taylor -
 #include <CLI/CLI.hpp>
+#include <cstdio>
 
 #include "mpm/core/cli.hpp"
 #include "mpm/core/error.hpp"
@@ -12,7 +13,8 @@ int main(int argc, char** argv) {
       "mpm-run: explicit material point method solver.\n"
       "Reads a model stream (from mpm-prep) and writes a result stream of frames and\n"
       "histories (for mpm-post). Exit status: 0 done, 2 bad input, 3 unstable run,\n"
-      "4 write failure, 128+N killed by signal N.",
+      "4 write failure, 128+N stopped by signal N (SIGINT, SIGTERM: after a checkpoint;\n"
+      "continue with --restart RESULT).",
       "mpm-run"};
   mpm::RunOptions opt;
   std::string progress = "auto";
@@ -35,11 +37,25 @@ int main(int argc, char** argv) {
   app.add_option("--progress", progress, "progress on stderr: auto, bar, lines or none")
       ->check(CLI::IsMember({"auto", "bar", "lines", "none"}))
       ->capture_default_str();
+  app.add_option("--restart", opt.restart,
+                 "continue the result stream RESULT from its last intact checkpoint (a run "
+                 "killed, cut or stopped by a signal); appends to RESULT, or writes -o")
+      ->type_name("RESULT");
+  std::string max_memory;
+  app.add_option("--max-memory", max_memory,
+                 "refuse a model whose run would need more memory (e.g. 16G; K, M, G, T are "
+                 "powers of 1024); default: the machine's memory");
   app.set_version_flag("--version", std::string("mpm-run ") + mpm::kVersion);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
+    // "--set bodies.bar.velocity=0 0 -190 m/s" unquoted: the shell split the value.
+    if (dynamic_cast<const CLI::ExtrasError*>(&e))
+      std::fprintf(stderr,
+                   "a --set value with spaces must be quoted for the shell: --set "
+                   "'bodies.bar.velocity=0 0 -190 m/s' or --set bodies.bar.velocity=\"0 0 -190 "
+                   "m/s\"\n");
     return code == 0 ? 0 : mpm::kExitBadInput;
   }
   opt.progress = progress == "bar"     ? mpm::ProgressMode::Bar
@@ -48,8 +64,14 @@ int main(int argc, char** argv) {
                                        : mpm::ProgressMode::Auto;
   return mpm::guarded_main("mpm-run", [&] {
     mpm::ignore_sigpipe();
+    if (!opt.restart.empty()) {
+      if (app.count("input"))
+        throw mpm::InputError("--restart", "continues a result stream; give no model stream");
+      if (!app.count("--output")) opt.output = opt.restart;  // append to it
+    }
     mpm::refuse_terminal_output(opt.output, "the result stream");
     mpm::check_output_file(opt.output, {opt.input});
+    if (!max_memory.empty()) opt.max_memory = mpm::parse_memory_size(max_memory, "--max-memory");
     return mpm::run_model(opt);
   });
 }

@@ -3,7 +3,9 @@
 # wall time, throughput, peak memory, and the debris front and width at 30.6 us (99.5th
 # percentile, with the maxima) against the experiment (200 mm, 145 mm). Also a side-view PNG.
 # Usage: ./study.sh BUILD_DIR VARIANT...   (coarse, small-1.06, small-1.59, small-2.12, large,
-#        axi-H: axisym.toml at H mm cells, 2 particles per cell, e.g. axi-0.265)
+#        axi-H: axisym.toml at H mm cells, 2 particles per cell, e.g. axi-0.265;
+#        till-VARIANT: VARIANT with lead's Tillotson EOS, docs/eos-tillotson.md, e.g.
+#        till-axi-0.265). THREADS=N sets mpm-run's threads (default 2).
 set -euo pipefail
 cd "$(dirname "$0")"
 bin=$1; shift
@@ -13,14 +15,17 @@ table=out/table.md
   echo "| variant | particles | cell mm | spacing mm | steps | wall s | Mpart-steps/s | peak MB | front p99.5 mm | width p99.5 mm | front max mm | width max mm | front vs exp | width vs exp |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 } > "$table"
+# Lead's Tillotson constants as derived in docs/eos-tillotson.md (before any V4 run with them).
+tillotson='materials.lead.eos={ model = "tillotson", a = 0.5, b = 2.27, A = "47.7 GPa", B = "25.5 GPa", E0 = "0.942 MJ/kg", E_iv = "0.264 MJ/kg", E_cv = "1.130 MJ/kg", alpha = 5, beta = 5 }'
 for variant in "$@"; do
   sets=()
   frames=6
   scene=scene.toml
-  case $variant in
+  base=${variant#till-}
+  case $base in
     coarse) ;;
     small-*)
-      cell=${variant#small-}
+      cell=${base#small-}
       n=$(python3 -c "print(round($cell / 0.53))")
       sets=(--set "grid.cell_size=$cell mm" --set "bodies.plate.particles_per_cell=$n"
             --set "bodies.sphere.particles_per_cell=$n" --set 'bodies.plate.size=6.36 140 140 mm') ;;
@@ -34,13 +39,14 @@ for variant in "$@"; do
             --set output.precision=float32) ;;
     axi-*)
       scene=axisym.toml
-      sets=(--set "grid.cell_size=${variant#axi-} mm") ;;
+      sets=(--set "grid.cell_size=${base#axi-} mm") ;;
     *) echo "unknown variant $variant" >&2; exit 2 ;;
   esac
+  [ "$base" = "$variant" ] || sets+=(--set "$tillotson")
   out=out/$variant.mpm
   start=$(date +%s.%N)
   "$bin/mpm-prep/mpm-prep" "$scene" "${sets[@]}" --set output.frames=$frames 2> out/prep_$variant.log |
-    "$bin/mpm-run/mpm-run" --stats --progress lines -o "$out" 2> out/run_$variant.log
+    "$bin/mpm-run/mpm-run" --threads "${THREADS:-2}" --stats --progress lines -o "$out" 2> out/run_$variant.log
   end=$(date +%s.%N)
   "$bin/mpm-post/mpm-post" debris "$out" --time "30.6 us" --expect-front "200 mm" --expect-width "145 mm" | tee out/debris_$variant.txt
   json=$("$bin/mpm-post/mpm-post" debris "$out" --time "30.6 us" --json)

@@ -83,7 +83,7 @@ TEST(Cli, BadScenesAreReportedWithFileLineAndKey) {
       {"no_particles.toml", "translate = \"0 0 2 mm\"", "translate = \"0 0 50 mm\"", {"block"}},
       {"open_mesh.toml",
        "shape = \"box\"\nsize = \"4 4 4 mm\"",
-       "shape = \"mesh\"\nfile = \"open.off\"",
+       "shape = \"mesh\"\nfile = \"open.off\"\nscale = 0.004",
        {"open.off", "closed"}},
       {"missing_mesh.toml",
        "shape = \"box\"\nsize = \"4 4 4 mm\"",

@@ -87,6 +87,18 @@ TEST(Debris, PlaneAxisPercentilesAndMaximum) {
   EXPECT_NEAR(r.width_p995, 0.995, tol);
   EXPECT_NEAR(r.width, 0.995, tol);
 
+  // From the impact face (plate centres from x = 0, surface at -0.5 mm): the same cloud, its
+  // distances 6 mm longer (the plate's thickness); the width does not change.
+  DebrisOptions impact;
+  impact.face = DebrisFace::Impact;
+  const DebrisResult f = DebrisMeter(scene, start.frame(0), impact).measure(later.frame(30e-6));
+  EXPECT_NEAR(f.face_plane, -0.5e-3, 1e-15);
+  EXPECT_EQ(f.cloud, 1000u);
+  EXPECT_NEAR(f.front_max, 1.006, tol);
+  EXPECT_NEAR(f.front_p995, 1.001, tol);
+  EXPECT_NEAR(f.front_p999, 1.005, tol);
+  EXPECT_EQ(f.width_p995, r.width_p995);
+
   DebrisOptions p90;
   p90.percentile = 90;
   const DebrisResult q = DebrisMeter(scene, start.frame(0), p90).measure(later.frame(30e-6));
@@ -232,6 +244,70 @@ TEST(Debris, MinFragmentDropsIsolatedParticles) {
   const DebrisResult d = DebrisMeter(scene, start.frame(0), blocks).measure(later.frame(30e-6));
   EXPECT_EQ(d.fragments, 6u);
   EXPECT_EQ(d.counted, 125u);
+}
+
+// A quarter model (slip faces y = 0 and z = 0 through the plate and the projectile) measures
+// as the whole cloud: the cloud of the whole model, mirrored by hand, and its quarter y, z > 0
+// give the same front, width and fragments, to round-off (the axis point is a sum in another
+// order). A fragment that lies across a plane is one fragment of the whole.
+TEST(Debris, QuarterModelMeasuresAsTheWholeCloud) {
+  Scene whole = two_bodies();
+  whole.bodies[0].size = Vec3(6e-3, 40e-3, 40e-3);
+  whole.bodies[0].translate = Vec3(2.5e-3, 0, 0);
+  whole.bodies[1].shape = ShapeKind::Sphere;
+  whole.bodies[1].radius = 2e-3;
+  whole.bodies[1].translate = Vec3(-3e-3, 0, 0);
+  Scene quarter = whole;
+  quarter.grid.domain_given = true;
+  quarter.grid.domain_min = Vec3(-10e-3, 0, 0);
+  quarter.grid.domain_max = Vec3(200e-3, 30e-3, 30e-3);
+  quarter.boundary.face[2] = quarter.boundary.face[4] = BoundaryType::Slip;  // y_min, z_min
+  const Symmetry sym = scene_symmetry(quarter);
+  ASSERT_EQ(sym.planes.size(), 2u);
+  EXPECT_EQ(sym.planes[0].axis, 1);
+  EXPECT_EQ(sym.planes[1].axis, 2);
+  // The quarter's particles (centres off the planes), and the whole made of their images.
+  Cloud start_q, later_q, start_w, later_w;
+  for (int i = 0; i <= 5; ++i)
+    for (int j = 0; j < 10; ++j)
+      for (int k = 0; k < 10; ++k) start_q.add(Vec3(i * kS, (j + 0.5) * kS, (k + 0.5) * kS), 0);
+  for (int i = -4; i <= -2; ++i) start_q.add(Vec3(i * kS, 0.5 * kS, 0.5 * kS), 1);
+  // Later: a block astride the corner of the planes, particles along y = 0.5 mm (one fragment
+  // across the plane y = 0 in the whole), and spread particles.
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k)
+        later_q.add(Vec3(20e-3 + i * kS, (j + 0.5) * kS, (k + 0.5) * kS), 1);
+  for (int i = 0; i < 30; ++i) later_q.add(Vec3(30e-3 + i * kS, 0.5 * kS, 10e-3), 0);
+  for (int k = 1; k <= 200; ++k)
+    later_q.add(Vec3(6e-3 + 0.7e-3 * k, 0.13e-3 * k + 0.2e-3, 0.11e-3 * (k % 37) + 0.1e-3), 0);
+  for (const auto* part : {&start_q, &later_q}) {
+    Cloud& w = part == &start_q ? start_w : later_w;
+    for (std::size_t i = 0; i < part->x.size(); ++i)
+      for (int im = 0; im < 4; ++im) w.add(sym.point_image(part->x[i], im), part->body[i]);
+  }
+  const DebrisResult a = DebrisMeter(whole, start_w.frame(0), {}).measure(later_w.frame(30e-6));
+  const DebrisResult b = DebrisMeter(quarter, start_q.frame(0), {}).measure(later_q.frame(30e-6));
+  EXPECT_TRUE(a.symmetry.planes.empty());
+  EXPECT_EQ(b.symmetry.images(), 4);
+  EXPECT_NEAR(b.plane, a.plane, 1e-15);
+  EXPECT_EQ(b.cloud, a.cloud);
+  EXPECT_EQ(b.total * 4, a.total);
+  EXPECT_EQ(b.fragments, a.fragments);
+  EXPECT_EQ(b.largest, a.largest);
+  EXPECT_GE(a.largest, 36u * 4);  // the block's four images touch: one fragment of the whole
+  const double tol = 1e-12;
+  EXPECT_NEAR(b.front, a.front, tol);
+  EXPECT_NEAR(b.front_max, a.front_max, tol);
+  EXPECT_NEAR(b.width, a.width, tol);
+  EXPECT_NEAR(b.width_max, a.width_max, tol);
+  EXPECT_NEAR(b.width_p99, a.width_p99, tol);
+  // Measured as it is (no planes), the quarter's cloud is narrower about the wrong axis.
+  DebrisOptions cut;
+  cut.symmetry = Symmetry{};
+  const DebrisResult c = DebrisMeter(quarter, start_q.frame(0), cut).measure(later_q.frame(30e-6));
+  EXPECT_EQ(c.cloud * 4, a.cloud);
+  EXPECT_GT(std::abs(c.width_max - a.width_max), 1e-3);
 }
 
 }  // namespace

@@ -279,7 +279,7 @@ TEST(Stream, HeaderBytes) {
     EXPECT_EQ(w.bytes_written(), 16u);
   }
   const Bytes b = slurp(p);
-  EXPECT_EQ(b, Bytes("\x89MPM\r\n\x1a\n\x01\x00\x01\x00\x00\x00\x00\x00", 16));  // 1.1
+  EXPECT_EQ(b, Bytes("\x89MPM\r\n\x1a\n\x01\x00\x03\x00\x00\x00\x00\x00", 16));  // 1.3
   // A stream with no records reads cleanly, but has not ended.
   Collected c;
   const StreamSummary s = read_stream(p, c.visitor());
@@ -347,6 +347,50 @@ TEST(Stream, RoundTripFile) {
   EXPECT_EQ(r.records_read(), 7u);
   EXPECT_EQ(r.frames_read(), 3u);
   EXPECT_EQ(r.offset(), written);
+}
+
+// A checkpoint (CHKP) keeps its state values and every column exactly, f64 as f64; frame
+// readers skip it and do not count it as a frame; a cut anywhere in it is truncation.
+TEST(Stream, CheckpointRoundTrip) {
+  TempDir d;
+  const std::string p = d.file("chkp.mpm");
+  StateValues state;
+  state.set("time", 1.2345678901234567e-5);
+  state.set("step", 9007199254740991.0);  // 2^53 - 1: counts stay exact
+  state.set("tiny", std::nextafter(0.0, 1.0));
+  const Frame f = make_frame(7, 5);
+  {
+    StreamWriter w(p);
+    w.write_frame(f, {}, Precision::Float32);
+    w.write_checkpoint(state, f);
+    w.write_end(0, "completed");
+  }
+  StreamReader r(p);
+  std::uint32_t type = 0;
+  ASSERT_TRUE(r.next(type));
+  r.skip();
+  ASSERT_TRUE(r.next(type));
+  ASSERT_EQ(type, std::uint32_t(RecordType::Checkpoint));
+  EXPECT_EQ(record_name(type), "CHKP");
+  const Checkpoint c = r.read_checkpoint();
+  ASSERT_EQ(c.state.items().size(), 3u);
+  for (const auto& [name, value] : state.items()) EXPECT_EQ(c.state.get(name), value) << name;
+  expect_frame(f, c.frame);  // every column, bitwise (Float64)
+  EXPECT_EQ(r.frames_read(), 1u);
+  EXPECT_THROW(c.state.get("absent"), InputError);
+  Collected col;
+  const StreamSummary s = read_stream(p, col.visitor());
+  EXPECT_EQ(s.damage, "");
+  EXPECT_EQ(s.frames, 1u);
+  EXPECT_TRUE(s.ended);
+  // Cut inside the checkpoint: truncation at that record, the frame before it intact.
+  const Bytes b = slurp(p);
+  const std::size_t chkp_at = b.find("CHKP");
+  ASSERT_NE(chkp_at, Bytes::npos);
+  spit(p, b.substr(0, chkp_at + 40));
+  const StreamSummary cut = read_stream(p, col.visitor());
+  EXPECT_NE(cut.damage.find("truncated in record 2 (CHKP"), std::string::npos) << cut.damage;
+  EXPECT_EQ(cut.frames, 1u);
 }
 
 TEST(Stream, VisitorWithoutFrames) {

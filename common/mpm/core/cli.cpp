@@ -2,10 +2,13 @@
 
 #include <unistd.h>
 
+#include <cctype>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <new>
+#include <string>
 
 #include "mpm/core/error.hpp"
 
@@ -47,6 +50,51 @@ void check_output_file(const std::string& output, const std::vector<std::string>
                        "is the input file '" + input +
                            "'; writing it would destroy the input: choose another output file");
   }
+}
+
+double machine_memory() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page > 0 ? double(pages) * double(page) : 0.0;
+}
+
+double parse_memory_size(const std::string& text, const std::string& option) {
+  std::size_t used = 0;
+  double v = -1;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  std::string unit = text.substr(used);
+  for (char& c : unit) c = char(std::toupper(static_cast<unsigned char>(c)));
+  if (unit.size() > 1 && (unit.ends_with("IB") || unit.ends_with("B")))
+    unit.erase(unit.size() - (unit.ends_with("IB") ? 2 : 1));
+  const std::string units = "KMGT";
+  double factor = 1;
+  if (unit == "B") unit.clear();
+  if (unit.size() == 1 && units.find(unit[0]) != std::string::npos)
+    factor = std::ldexp(1.0, 10 * (1 + int(units.find(unit[0]))));
+  else if (!unit.empty())
+    used = 0;
+  if (used == 0 || !(v > 0) || !std::isfinite(v))
+    throw InputError(option,
+                     "expected a memory size such as 16G, 512M or 2000000000 (bytes; K, "
+                     "M, G, T are powers of 1024), got '" +
+                         text + "'");
+  return v * factor;
+}
+
+std::string format_bytes(double bytes) {
+  static const char* names[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB"};
+  int k = 0;
+  double v = bytes;
+  while (v >= 1024 && k < 5) v /= 1024, ++k;
+  char b[48];
+  if (v >= 1024)
+    std::snprintf(b, sizeof b, "%.3g bytes", bytes);
+  else
+    std::snprintf(b, sizeof b, k == 0 ? "%.0f %s" : "%.3g %s", v, names[k]);
+  return b;
 }
 
 void ignore_sigpipe() {

@@ -20,6 +20,18 @@ void refuse_terminal_output(const std::string& path, const char* what);
 /// that does not exist yet.
 void check_output_file(const std::string& output, const std::vector<std::string>& inputs);
 
+/// The machine's physical memory in bytes (sysconf); 0 when unknown.
+double machine_memory();
+
+/// A memory size given on the command line (--max-memory): a number of bytes with an optional
+/// suffix K, M, G or T (powers of 1024; "KB", "KiB" and lower case alike), e.g. "16G",
+/// "512M". Throws InputError naming `option` when it is not one.
+double parse_memory_size(const std::string& text, const std::string& option);
+
+/// A number of bytes for messages in KiB, MiB, GiB, TiB or PiB, 3 significant digits
+/// ("1.5 GiB"); larger as "1.2e+24 bytes".
+std::string format_bytes(double bytes);
+
 /// Ignores SIGPIPE so that a closed pipe shows up as a write error (IoError) with a message.
 void ignore_sigpipe();
 

@@ -342,6 +342,7 @@ std::string describe(const Dimension& d) {
       {dim::energy, "an energy (J)"},
       {dim::rate, "a rate (1/s)"},
       {dim::specific_heat, "a specific heat (J/(kg*K))"},
+      {dim::specific_energy, "a specific energy (J/kg)"},
   };
   for (const auto& n : kNames) {
     if (n.dim == d) return std::string(n.text);

@@ -26,8 +26,9 @@ inline constexpr Dimension density{1, -3, 0, 0};
 inline constexpr Dimension pressure{1, -1, -2, 0};  ///< also stress, modulus
 inline constexpr Dimension force{1, 1, -2, 0};
 inline constexpr Dimension energy{1, 2, -2, 0};
-inline constexpr Dimension rate{0, 0, -1, 0};            ///< strain rate, 1/s
-inline constexpr Dimension specific_heat{0, 2, -2, -1};  ///< J/(kg*K)
+inline constexpr Dimension rate{0, 0, -1, 0};             ///< strain rate, 1/s
+inline constexpr Dimension specific_heat{0, 2, -2, -1};   ///< J/(kg*K)
+inline constexpr Dimension specific_energy{0, 2, -2, 0};  ///< J/kg
 }  // namespace dim
 
 /// A number and its dimension, value in SI.

@@ -38,6 +38,42 @@ int conclude(const std::string& path, const StreamSummary& s, std::size_t frames
   return kExitOk;
 }
 
+std::string stream_producer(const std::string& path) {
+  if (path == "-") return "";
+  struct Stop {};  // thrown by the visitor at the first INFO record: nothing more is read
+  std::string producer;
+  StreamVisitor v;
+  v.want_frames = false;
+  v.info = [&](const std::string& text) {
+    const std::string key = "tool = \"";
+    const auto at = text.find(key);
+    if (at != std::string::npos) {
+      const auto end = text.find('"', at + key.size());
+      if (end != std::string::npos) producer = text.substr(at + key.size(), end - at - key.size());
+    }
+    throw Stop{};
+  };
+  v.frame = [&](Frame&&) { throw Stop{}; };
+  try {
+    (void)read_stream(path, v);
+  } catch (const Stop&) {
+  }
+  return producer;
+}
+
+void require_result(const std::string& path, const std::string& command) {
+  if (stream_producer(path) == "mpm-prep")
+    throw InputError(input_name(path),
+                     "this is a model from mpm-prep, not a result: run mpm-run on it (mpm-run " +
+                         path + " -o result.mpm), then mpm-post " + command + " on the result");
+}
+
+void check_written(std::FILE* out, const std::string& path) {
+  if (std::ferror(out))
+    throw IoError("cannot write '" + (path == "-" ? std::string("stdout") : path) +
+                  "': " + std::strerror(errno));
+}
+
 std::FILE* open_output(const std::string& path) {
   std::FILE* f = path == "-" ? stdout : std::fopen(path.c_str(), "w");
   if (!f) throw IoError("cannot write '" + path + "': " + std::strerror(errno));
@@ -48,8 +84,8 @@ void close_output(std::FILE* out, const std::string& path) {
   if (out != stdout) {
     if (std::fclose(out) != 0)
       throw IoError("cannot write '" + path + "': " + std::strerror(errno));
-  } else {
-    std::fflush(stdout);
+  } else if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    throw IoError(std::string("cannot write stdout: ") + std::strerror(errno));
   }
 }
 

@@ -22,6 +22,19 @@ Scene scene_of(const std::string& text, const std::string& path);
 /// status); else 0. Messages go to stderr.
 int conclude(const std::string& path, const StreamSummary& summary, std::size_t frames_used);
 
+/// The tool that wrote the stream file `path`, as its first INFO record names it ("mpm-prep"
+/// for a model, "mpm-run" for a result); empty for stdin (not read twice) or when unknown.
+/// Reads only the records before the first frame.
+std::string stream_producer(const std::string& path);
+
+/// Throws InputError when `path` is a model from mpm-prep: `command` measures a result, so
+/// the message says to run mpm-run on it.
+void require_result(const std::string& path, const std::string& command);
+
+/// Throws IoError when a write to `out` failed (a closed pipe, a full disk): writers call it
+/// once a row, so a closed pipe stops the command at its first failed write.
+void check_written(std::FILE* out, const std::string& path);
+
 /// An output of a subcommand: stdout for "-", else the file opened for writing. Throws IoError.
 std::FILE* open_output(const std::string& path);
 

@@ -48,6 +48,7 @@ struct TaylorArgs {
   std::string expect_D;     ///< reference diameter to compare with; empty: none
   bool surface = false;     ///< measure the surface instead of the particle centres
   bool json = false;        ///< print JSON (SI units)
+  std::string symmetry;     ///< mirror planes (option_symmetry); empty: the scene's
 };
 int post_taylor(const TaylorArgs& args);
 
@@ -57,6 +58,7 @@ struct DebrisArgs {
   std::string time;              ///< the frame nearest this time; empty: the last
   std::string axis;              ///< impact axis "x", "y" or "z"; empty: the projectile's velocity
   std::string plane;             ///< reference plane (length); empty: the target's rear face
+  std::string face = "rear";     ///< the face the front is measured from: "rear" or "impact"
   std::string target;            ///< target body; empty: the first body at rest
   std::string projectile;        ///< projectile body; empty: the fastest body
   std::string expect_front;      ///< reference front (length); empty: none
@@ -64,9 +66,24 @@ struct DebrisArgs {
   std::string link;              ///< fragments' linking length; empty: the grid's cell size
   double percentile = 99.5;      ///< the headline front and width are this percentile, %
   std::size_t min_fragment = 1;  ///< only fragments of at least this many particles count
+  bool escaped = false;          ///< also count the particles that left the domain (ESCP)
   bool json = false;             ///< print JSON (SI units)
+  std::string symmetry;          ///< mirror planes (option_symmetry); empty: the scene's
 };
 int post_debris(const DebrisArgs& args);
+
+/// mpm-post crater: depth and diameter of a target's crater (or hole), and how deep each body
+/// went (CraterMeter), on the frame nearest a time or the last.
+struct CraterArgs {
+  std::string input = "-";  ///< stream ("-": stdin)
+  std::string time;         ///< the frame nearest this time; empty: the last
+  std::string target;       ///< target body; empty: the first body at rest
+  std::string projectile;   ///< projectile body (the axis goes through it); empty: the fastest
+  std::string axis;         ///< impact axis "x", "y" or "z"; empty: the projectile's velocity
+  std::string symmetry;     ///< mirror planes (option_symmetry); empty: the scene's
+  bool json = false;        ///< print JSON (SI units)
+};
+int post_crater(const CraterArgs& args);
 
 /// mpm-post profile: a field along a line (make_profile) of one or more frames, CSV or JSON.
 struct ProfileArgs {
@@ -82,6 +99,7 @@ struct ProfileArgs {
   ProfileOptions profile;          ///< field and bins as given; the rest is set from the above
   bool json = false;               ///< print JSON (SI units)
   bool grid = false;               ///< profile the field projected onto the run's grid nodes
+  std::string weight = "volume";   ///< bins' means weighted by particle "volume" or "mass"
 };
 int post_profile(const ProfileArgs& args);
 

@@ -5,10 +5,12 @@
 
 #include "mpm/core/error.hpp"
 #include "mpm/post/arguments.hpp"
+#include "mpm/post/column_value.hpp"
 #include "mpm/post/command_io.hpp"
 #include "mpm/post/commands.hpp"
 #include "mpm/post/json.hpp"
 #include "mpm/post/post.hpp"
+#include "mpm/post/symmetry.hpp"
 
 namespace mpm {
 
@@ -28,6 +30,8 @@ void print_taylor_json(const TaylorResult& r, std::optional<double> eL, std::opt
   j.key("spacing").number(r.spacing).key("particles").integer(r.particles);
   j.key("D_min").number(r.D_min).key("D_max").number(r.D_max);
   j.key("D_radius").number(r.D_radius);
+  j.key("symmetry");
+  write_symmetry_json(j, r.symmetry);
   if (eL) j.key("expected_L").number(*eL).key("error_L").number(r.L / *eL - 1);
   if (eD) j.key("expected_D").number(*eD).key("error_D").number(r.D / *eD - 1);
   j.end_object();
@@ -39,6 +43,7 @@ void print_taylor_text(const TaylorResult& r, std::optional<double> eL, std::opt
               r.time * 1e6,
               r.measure == "centres" ? "particle centres" : "surface: centres + half a spacing",
               "xyz"[r.axis], r.wall * 1e3, r.particles);
+  if (!r.symmetry.describe().empty()) std::printf("  %s\n", r.symmetry.describe().c_str());
   std::printf("  L = %.3f mm", r.L * 1e3);
   if (eL) std::printf("   expected %.3f mm, %+.2f%%", *eL * 1e3, 100 * (r.L / *eL - 1));
   std::printf("   (L0 = %.3f mm, L/L0 = %.4f)\n", r.L0 * 1e3, r.L / r.L0);
@@ -52,10 +57,38 @@ void print_taylor_text(const TaylorResult& r, std::optional<double> eL, std::opt
         r.D_min * 1e3, r.D_max * 1e3, r.D_radius * 1e3);
 }
 
-void print_debris_json(const DebrisResult& r, std::optional<double> ef, std::optional<double> ew) {
+/// The particles that left the domain by the measured frame's time (ESCP records), and those
+/// of them that left downstream of the plane: part of the cloud, gone from the frame.
+struct EscapedCount {
+  std::size_t n = 0, behind = 0;
+  double mass = 0, mass_behind = 0;  ///< kg (whole rings in axisymmetry)
+};
+
+EscapedCount count_escaped(const std::vector<Frame>& records, const DebrisResult& r,
+                           double factor) {
+  EscapedCount c;
+  for (const Frame& f : records) {
+    const Column *x = f.columns.find("x"), *m = f.columns.find("m"), *t = f.columns.find("t_exit");
+    if (!x || !m || !t) continue;
+    for (std::size_t i = 0; i < f.columns.size(); ++i) {
+      if (column_value(*t, i, 0) > r.time * (1 + 1e-12)) continue;
+      const double m_p = factor * column_value(*m, i, 0);
+      const bool behind = r.direction * (column_value(*x, i, r.axis) - r.plane) > 0;
+      ++c.n;
+      c.mass += m_p;
+      if (behind) ++c.behind, c.mass_behind += m_p;
+    }
+  }
+  return c;
+}
+
+void print_debris_json(const DebrisResult& r, std::optional<double> ef, std::optional<double> ew,
+                       const std::optional<EscapedCount>& esc) {
   JsonWriter j;
   j.begin_object().key("time").number(r.time).key("axis").string(std::string(1, "xyz"[r.axis]));
   j.key("direction").integer(r.direction).key("plane").number(r.plane);
+  j.key("face").string(r.face == DebrisFace::Impact ? "impact" : "rear");
+  j.key("face_plane").number(r.face_plane);
   j.key("cloud_particles").integer(r.cloud).key("particles").integer(r.total);
   j.key("percentile").number(r.percentile).key("front").number(r.front);
   j.key("width").number(r.width).key("front_max").number(r.front_max);
@@ -67,8 +100,15 @@ void print_debris_json(const DebrisResult& r, std::optional<double> ef, std::opt
   j.key("fragments").integer(r.fragments).key("single_particle_fragments").integer(r.singles);
   j.key("largest_fragment").integer(r.largest).key("counted_particles").integer(r.counted);
   j.key("percentiles_of").string(r.by_mass ? "mass" : "particles");
+  j.key("symmetry");
+  write_symmetry_json(j, r.symmetry);
   if (ef) j.key("expected_front").number(*ef).key("error_front").number(r.front / *ef - 1);
   if (ew) j.key("expected_width").number(*ew).key("error_width").number(r.width / *ew - 1);
+  if (esc) {
+    j.key("escaped_particles").integer(esc->n).key("escaped_mass").number(esc->mass);
+    j.key("escaped_behind_plane").integer(esc->behind);
+    j.key("escaped_behind_plane_mass").number(esc->mass_behind);
+  }
   j.end_object();
   std::printf("%s\n", j.text().c_str());
 }
@@ -79,6 +119,10 @@ void print_debris_text(const DebrisResult& r, std::optional<double> ef, std::opt
       "(the target's rear face), impact along %s%c\n",
       r.time * 1e6, r.cloud, r.total, "xyz"[r.axis], r.plane * 1e3, r.direction > 0 ? "+" : "-",
       "xyz"[r.axis]);
+  if (!r.symmetry.describe().empty()) std::printf("  %s\n", r.symmetry.describe().c_str());
+  if (r.face == DebrisFace::Impact)
+    std::printf("  front measured from the target's impact face %c = %.3f mm\n", "xyz"[r.axis],
+                r.face_plane * 1e3);
   std::printf(
       "  fragments (particles closer than %.3g mm linked): %zu, %zu of them single particles, "
       "the "
@@ -113,7 +157,11 @@ int post_taylor(const TaylorArgs& a) {
   if (!a.axis.empty()) opt.axis = option_axis(a.axis, "--axis");
   if (!a.wall.empty()) opt.wall = option_quantity(a.wall, dim::length, "--wall");
   StreamVisitor v;
-  v.scene = [&](const std::string& t) { meter.emplace(scene_of(t, path), opt); };
+  v.scene = [&](const std::string& t) {
+    const Scene scene = scene_of(t, path);
+    opt.symmetry = measure_symmetry(a.symmetry, scene);
+    meter.emplace(scene, opt);
+  };
   v.frame = [&](Frame&& f) {
     ++frames;
     if (!meter) throw StreamError(input_name(path), "a frame comes before the scene record");
@@ -150,6 +198,7 @@ int post_debris(const DebrisArgs& a) {
   if (!a.link.empty()) opt.link = option_quantity(a.link, dim::length, "--link");
   if (!a.axis.empty()) opt.axis = option_axis(a.axis, "--axis");
   if (!a.plane.empty()) opt.plane = option_quantity(a.plane, dim::length, "--plane");
+  opt.face = a.face == "impact" ? DebrisFace::Impact : DebrisFace::Rear;
   std::optional<double> at;
   if (!a.time.empty()) at = option_quantity(a.time, dim::time, "--time");
   std::optional<Scene> scene;
@@ -157,8 +206,13 @@ int post_debris(const DebrisArgs& a) {
   std::optional<DebrisResult> chosen;
   double best = 1e300;
   std::size_t frames = 0;
+  std::vector<Frame> escaped;
   StreamVisitor v;
-  v.scene = [&](const std::string& t) { scene = scene_of(t, path); };
+  v.scene = [&](const std::string& t) {
+    scene = scene_of(t, path);
+    opt.symmetry = measure_symmetry(a.symmetry, *scene);
+  };
+  if (a.escaped) v.escapes = [&](Frame&& f) { escaped.push_back(std::move(f)); };
   v.frame = [&](Frame&& f) {
     ++frames;
     if (!scene) throw StreamError(input_name(path), "a frame comes before the scene record");
@@ -177,10 +231,18 @@ int post_debris(const DebrisArgs& a) {
   }
   const std::optional<double> ef = optional_length(a.expect_front, "--expect-front");
   const std::optional<double> ew = optional_length(a.expect_width, "--expect-width");
-  if (a.json)
-    print_debris_json(*chosen, ef, ew);
-  else
+  std::optional<EscapedCount> esc;
+  if (a.escaped) esc = count_escaped(escaped, *chosen, scene->measure_factor());
+  if (a.json) {
+    print_debris_json(*chosen, ef, ew, esc);
+  } else {
     print_debris_text(*chosen, ef, ew);
+    if (esc)
+      std::printf(
+          "  escaped (left the domain by then): %zu particles, %.4g kg; %zu of them, %.4g kg, "
+          "behind the plane\n",
+          esc->n, esc->mass, esc->behind, esc->mass_behind);
+  }
   std::fflush(stdout);
   return conclude(path, s, frames);
 }

@@ -5,12 +5,13 @@
 
 #include "mpm/core/error.hpp"
 #include "mpm/post/calipers.hpp"
+#include "mpm/post/impact.hpp"
 #include "mpm/scene/particles.hpp"
 
 namespace mpm {
 
 TaylorMeter::TaylorMeter(const Scene& scene, const TaylorOptions& options)
-    : scene_(scene), opt_(options) {
+    : scene_(scene), opt_(options), symmetry_(options.symmetry.value_or(scene_symmetry(scene))) {
   if (scene_.bodies.empty()) throw InputError("taylor", "the scene has no bodies");
   body_ = 0;
   if (!opt_.body.empty()) {
@@ -23,38 +24,29 @@ TaylorMeter::TaylorMeter(const Scene& scene, const TaylorOptions& options)
 
 TaylorResult TaylorMeter::measure(const Frame& frame) const {
   const int d = scene_.dimension;
-  const Column* xc = frame.columns.find(col::x);
-  const Column* bc = frame.columns.find(col::body);
-  if (!xc || !bc) throw InputError("taylor", "frames need the columns 'x' and 'body'");
-  const auto* x = reinterpret_cast<const double*>(xc->data());
-  const auto* body = reinterpret_cast<const std::uint8_t*>(bc->data());
-  const std::size_t n = frame.columns.size();
-  const Column* mc = frame.columns.find(col::m);
-  const double* m = mc ? reinterpret_cast<const double*>(mc->data()) : nullptr;
-
   TaylorResult r;
   r.time = frame.time;
+  r.symmetry = symmetry_;
   const BodySpec& spec = scene_.bodies[body_];
   r.spacing = spec.spacing(scene_.grid.cell_size);
   r.measure = opt_.surface ? "surface" : "centres";
-
-  // Bounding box and mass centre of the body's particles.
-  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300), centre = Vec3::Zero();
-  double mass = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (body[i] != body_) continue;
-    ++r.particles;
-    const double w = m ? m[i] : 1.0;
-    for (int a = 0; a < d; ++a) {
-      lo[a] = std::min(lo[a], x[i * d + a]);
-      hi[a] = std::max(hi[a], x[i * d + a]);
-      centre[a] += w * x[i * d + a];
-    }
-    mass += w;
-  }
+  // The whole bar: the body's particles and their mirror images.
+  const WholeBody whole = unfold(frame, d, symmetry_, {body_});
+  const std::vector<Vec3>& x = whole.x;
+  r.particles = whole.particles;
   if (r.particles == 0)
     throw InputError("taylor", "body '" + spec.name + "' has no particles in the frame at t = " +
                                    std::to_string(frame.time) + " s");
+
+  // Bounding box and mass centre of the bar.
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300), centre = Vec3::Zero();
+  double mass = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    lo = lo.cwiseMin(x[i]);
+    hi = hi.cwiseMax(x[i]);
+    centre += whole.m[i] * x[i];
+    mass += whole.m[i];
+  }
   centre /= mass;
 
   // Axis: as given, else the longest extent of the body.
@@ -89,24 +81,16 @@ TaylorResult TaylorMeter::measure(const Frame& frame) const {
 
   double L = 0, R = 0;
   std::vector<double> u, w;  // the particles' coordinates across the axis (3D)
-  if (d == 3) u.reserve(r.particles), w.reserve(r.particles);
+  if (d == 3) u.reserve(x.size()), w.reserve(x.size());
   const int a1 = (ax + 1) % 3, a2 = (ax + 2) % 3;
-  double lat_lo = 1e300, lat_hi = -1e300;  // 2D: the one coordinate across the axis
-  const int lat = d == 2 ? 1 - ax : -1;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (body[i] != body_) continue;
-    L = std::max(L, std::abs(x[i * d + ax] - r.wall));
+  const int lat = d == 2 ? 1 - ax : -1;  // 2D: the one coordinate across the axis
+  for (const Vec3& p : x) {
+    L = std::max(L, std::abs(p[ax] - r.wall));
     double r2 = 0;
     for (int a = 0; a < d; ++a)
-      if (a != ax) r2 += (x[i * d + a] - centre[a]) * (x[i * d + a] - centre[a]);
+      if (a != ax) r2 += (p[a] - centre[a]) * (p[a] - centre[a]);
     R = std::max(R, std::sqrt(r2));
-    if (d == 3) {
-      u.push_back(x[i * d + a1]);
-      w.push_back(x[i * d + a2]);
-    } else {
-      lat_lo = std::min(lat_lo, x[i * d + lat]);
-      lat_hi = std::max(lat_hi, x[i * d + lat]);
-    }
+    if (d == 3) u.push_back(p[a1]), w.push_back(p[a2]);
   }
   const double add = opt_.surface ? r.spacing : 0.0;
   r.L = L + 0.5 * add;
@@ -116,9 +100,9 @@ TaylorResult TaylorMeter::measure(const Frame& frame) const {
     r.D_radius = 2 * R + add;
   } else if (scene_.axisymmetric) {
     // x is the radius (never negative): the foot is a disc twice its largest radius across.
-    r.D = r.D_min = r.D_max = r.D_radius = 2 * lat_hi + add;
+    r.D = r.D_min = r.D_max = r.D_radius = 2 * hi[lat] + add;
   } else {
-    r.D = r.D_min = r.D_max = lat_hi - lat_lo + add;
+    r.D = r.D_min = r.D_max = hi[lat] - lo[lat] + add;
     r.D_radius = 2 * R + add;
   }
   return r;
@@ -238,101 +222,52 @@ std::vector<std::size_t> fragment_sizes(const std::vector<Vec3>& points, double 
 }
 
 DebrisMeter::DebrisMeter(const Scene& scene, const Frame& first, const DebrisOptions& options)
-    : opt_(options) {
-  const Column* xc = first.columns.find(col::x);
-  const Column* vc = first.columns.find(col::v);
-  const Column* bc = first.columns.find(col::body);
-  if (!xc || !vc || !bc) throw InputError("debris", "frames need the columns 'x', 'v' and 'body'");
-  dim_ = xc->info().components;
-  const auto* x = reinterpret_cast<const double*>(xc->data());
-  const auto* v = reinterpret_cast<const double*>(vc->data());
-  const auto* body = reinterpret_cast<const std::uint8_t*>(bc->data());
-  const std::size_t n = first.columns.size();
-  const int nb = int(scene.bodies.size());
-  auto find = [&](const std::string& name, const char* option) {
-    const int b = scene.body_index(name);
-    if (b < 0) throw InputError(option, "no body named '" + name + "' in the scene");
-    return b;
-  };
-  // Projectile: the fastest body; target: the first body at rest.
-  int proj = opt_.projectile.empty() ? -1 : find(opt_.projectile, "--projectile");
-  int target = opt_.target.empty() ? -1 : find(opt_.target, "--target");
-  if (proj < 0) {
-    double best = 0;
-    for (int b = 0; b < nb; ++b)
-      if (scene.bodies[b].velocity.norm() > best) best = scene.bodies[b].velocity.norm(), proj = b;
-    if (proj < 0) throw InputError("debris", "no body moves at t = 0: give --projectile");
-  }
-  if (target < 0) {
-    for (int b = 0; b < nb && target < 0; ++b)
-      if (b != proj && scene.bodies[b].velocity.norm() == 0) target = b;
-    if (target < 0) throw InputError("debris", "no body is at rest at t = 0: give --target");
-  }
-  const Vec3 vp = scene.bodies[proj].velocity;
+    : opt_(options), symmetry_(options.symmetry.value_or(scene_symmetry(scene))) {
+  const Impact im =
+      find_impact(scene, first, symmetry_, {opt_.axis, opt_.projectile, opt_.target}, "debris");
+  dim_ = im.dimension;
   axisymmetric_ = scene.axisymmetric;
-  axis_ = opt_.axis;
-  if (axisymmetric_ && axis_ >= 0 && axis_ != 1)
-    throw InputError(
-        "--axis",
-        "an axisymmetric scene's impact axis is its axis of revolution y (x is the radius)");
-  if (axisymmetric_) axis_ = 1;
-  if (axis_ < 0) {
-    axis_ = 0;
-    for (int a = 1; a < dim_; ++a)
-      if (std::abs(vp[a]) > std::abs(vp[axis_])) axis_ = a;
-  }
-  direction_ = vp[axis_] < 0 ? -1 : 1;
-  // The projectile's initial centre, and the target's rear face (surface).
-  double far = -1e300;
-  std::size_t np = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (body[i] == proj) {
-      for (int a = 0; a < dim_; ++a) point_[a] += x[i * dim_ + a];
-      ++np;
-    }
-    if (body[i] == target) far = std::max(far, direction_ * x[i * dim_ + axis_]);
-  }
-  if (np == 0 || far < -1e299)
-    throw InputError("debris", "the first frame lacks the projectile or the target");
-  point_ /= double(np);
-  if (axisymmetric_) point_.x() = 0;  // the axis of revolution, whatever the projectile's rings
-  const double spacing = scene.bodies[target].spacing(scene.grid.cell_size);
-  plane_ = opt_.plane ? *opt_.plane : direction_ * (far + 0.5 * spacing);
+  axis_ = im.axis;
+  direction_ = im.direction;
+  point_ = im.point;
+  // The reference plane: the whole target's rear face (surface: centres + half a spacing).
+  const double spacing = scene.bodies[im.target].spacing(scene.grid.cell_size);
+  plane_ = opt_.plane ? *opt_.plane : im.direction * (im.rear + 0.5 * spacing);
+  // The face the front is measured from: the rear face, or the struck face (surface).
+  face_plane_ =
+      opt_.face == DebrisFace::Impact ? im.direction * (im.front - 0.5 * spacing) : plane_;
   link_ = opt_.link > 0 ? opt_.link : scene.grid.cell_size;
   if (opt_.min_fragment < 1) throw InputError("--min-fragment", "expected at least 1 particle");
-  (void)v;
 }
 
 DebrisResult DebrisMeter::measure(const Frame& frame) const {
-  const auto* x = reinterpret_cast<const double*>(frame.columns.at(col::x).data());
-  const std::size_t n = frame.columns.size();
+  const WholeBody whole = unfold(frame, dim_, symmetry_, {});
   DebrisResult r;
   r.time = frame.time;
   r.axis = axis_;
   r.direction = direction_;
   r.plane = plane_;
+  r.face = opt_.face;
+  r.face_plane = face_plane_;
   r.axis_point = point_;
-  r.total = n;
+  r.total = whole.particles;
   r.percentile = opt_.percentile;
   r.link = link_;
   r.min_fragment = opt_.min_fragment;
-  const Column* mc = frame.columns.find(col::m);
-  const double* m = mc ? reinterpret_cast<const double*>(mc->data()) : nullptr;
-  if (axisymmetric_ && !m)
+  r.symmetry = symmetry_;
+  if (axisymmetric_ && !frame.columns.find(col::m))
     throw InputError("debris", "an axisymmetric frame needs the column 'm' (the rings' masses)");
   std::vector<double> front, width, mass;
   std::vector<Vec3> cloud;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double d = direction_ * (x[i * dim_ + axis_] - plane_);
+  for (std::size_t i = 0; i < whole.x.size(); ++i) {
+    const Vec3& p = whole.x[i];
+    const double d = direction_ * (p[axis_] - plane_);
     if (!(d > 0)) continue;
-    mass.push_back(m ? m[i] : 1.0);
+    mass.push_back(whole.m[i]);
     double r2 = 0;
-    Vec3 p = Vec3::Zero();
-    for (int a = 0; a < dim_; ++a) {
-      p[a] = x[i * dim_ + a];
-      if (a != axis_) r2 += (x[i * dim_ + a] - point_[a]) * (x[i * dim_ + a] - point_[a]);
-    }
-    front.push_back(d);
+    for (int a = 0; a < dim_; ++a)
+      if (a != axis_) r2 += (p[a] - point_[a]) * (p[a] - point_[a]);
+    front.push_back(direction_ * (p[axis_] - face_plane_));
     width.push_back(2 * std::sqrt(r2));
     cloud.push_back(p);
   }

@@ -31,6 +31,7 @@ struct ProfiledParticles {
   const Column* rc;
   int dim;
   int wanted_body;
+  bool by_mass;  ///< weights m, else m / rho
 
   Vec3 pos(std::size_t i) const {
     Vec3 x = Vec3::Zero();
@@ -41,6 +42,7 @@ struct ProfiledParticles {
     return wanted_body < 0 || column_value(*body, i, 0) == wanted_body;
   }
   double weight(std::size_t i) const {
+    if (by_mass) return column_value(*mc, i, 0);
     return mc && rc ? column_value(*mc, i, 0) / column_value(*rc, i, 0) : 1.0;
   }
 };
@@ -239,7 +241,11 @@ Profile make_profile(const Frame& frame, int dim, const ProfileOptions& o) {
   Profile p;
   p.time = frame.time;
   const std::function<double(std::size_t)> value = field_values(frame, o, p);
-  const ProfiledParticles pp{xc, cols.find("body"), cols.find("m"), cols.find("rho"), dim, o.body};
+  const bool by_mass = o.weight == ProfileWeight::Mass;
+  const ProfiledParticles pp{
+      xc, cols.find("body"), cols.find("m"), cols.find("rho"), dim, o.body, by_mass};
+  if (by_mass && !pp.mc && !o.on_grid)
+    throw InputError("--weight", "mass weights need the column 'm', which the frames lack");
   if (o.body >= 0 && !pp.body) throw InputError("--body", "the frames hold no column 'body'");
 
   // The line: as given, or along the axis over the particles' extent through their centroid.

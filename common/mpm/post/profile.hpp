@@ -12,6 +12,10 @@
 
 namespace mpm {
 
+/// What a particle weighs in a bin's mean: its volume m / rho (a mean over space), or its
+/// mass m (a mean over material: momentum-like, as the grid transfers weigh it).
+enum class ProfileWeight { Volume, Mass };
+
 struct ProfileOptions {
   std::string field = "sigma";   ///< a column, or "pressure", "von_mises", "speed" (derived)
   int component = 0;             ///< of a vector or tensor column (sigma in Voigt order xx yy zz
@@ -23,6 +27,7 @@ struct ProfileOptions {
       std::numeric_limits<double>::infinity();  ///< m: particles farther off are left out
   int body = -1;                                ///< only this body's particles; -1: all
   int bins = 0;  ///< 0: one row per particle; else equal bins over the line
+  ProfileWeight weight = ProfileWeight::Volume;  ///< particles' weights (on the grid: mass)
   /// On the grid: the field projected onto the nodes of the run's uniform grid (cell size
   /// `cell`, a node at `origin`) with the linear shape functions, weighted by particle mass as
   /// the solver's particle-to-grid transfer weights momentum; the rows are then the nodes within
@@ -34,9 +39,10 @@ struct ProfileOptions {
 
 /// One profile. Per particle (bins = 0): s, value, weight (sorted by s). In bins: s is the bin
 /// centre, value the weighted mean, min and max the extremes, count the particles.
-/// Weights are particle volumes m / rho (m^3, per metre in 2D) when the frame holds m and rho,
-/// else 1. On the grid the rows are nodes and the weights their masses (kg; 1 a particle
-/// without the column m).
+/// Weights are particle volumes m / rho (m^3, per metre in 2D, per radian in axisymmetry) when
+/// the frame holds m and rho, else 1; with ProfileWeight::Mass particle masses m (kg). On the
+/// grid the rows are nodes and the weights their masses (kg; 1 a particle without the column
+/// m).
 struct Profile {
   double time = 0;  ///< s
   Vec3 from = Vec3::Zero(), to = Vec3::Zero();

@@ -24,6 +24,9 @@ ProfileOptions profile_options(const ProfileArgs& a) {
     throw InputError(a.from.empty() ? "--from" : "--to", "give both --from and --to");
   if (!a.from.empty()) o.from = option_point(a.from, "--from"), o.to = option_point(a.to, "--to");
   if (!a.radius.empty()) o.radius = option_quantity(a.radius, dim::length, "--radius");
+  if (a.weight != "volume" && a.weight != "mass")
+    throw InputError("--weight", "expected volume or mass, got '" + a.weight + "'");
+  o.weight = a.weight == "mass" ? ProfileWeight::Mass : ProfileWeight::Volume;
   return o;
 }
 
@@ -104,6 +107,7 @@ void write_profiles_json(std::FILE* out, const std::vector<Profile>& profiles,
   JsonWriter j;
   j.begin_object().key("field").string(o.field).key("component").integer(o.component);
   j.key("unit").string(p0.unit);
+  j.key("weighted_by").string(o.on_grid || o.weight == ProfileWeight::Mass ? "mass" : "volume");
   j.key("from").numbers({p0.from[0], p0.from[1], p0.from[2]});
   j.key("to").numbers({p0.to[0], p0.to[1], p0.to[2]});
   j.key("profiles").begin_array();

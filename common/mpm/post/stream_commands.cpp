@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "mpm/core/error.hpp"
+#include "mpm/core/types.hpp"
 #include "mpm/post/arguments.hpp"
 #include "mpm/post/column_value.hpp"
 #include "mpm/post/command_io.hpp"
@@ -14,6 +15,45 @@
 namespace mpm {
 
 namespace {
+
+/// Mass (kg) and momentum (kg m/s) of a set of particles: a frame, or escaped particles.
+struct Sums {
+  std::size_t n = 0;
+  double mass = 0;
+  Vec3 momentum = Vec3::Zero();
+  /// Adds the particles of `f` (its columns m and v; false when it has not both).
+  bool add(const Frame& f) {
+    const Column *m = f.columns.find("m"), *v = f.columns.find("v");
+    if (!m || !v) return false;
+    const int d = v->info().components;
+    n += f.columns.size();
+    for (std::size_t i = 0; i < f.columns.size(); ++i) {
+      const double m_p = column_value(*m, i, 0);
+      mass += m_p;
+      for (int a = 0; a < d && a < 3; ++a) momentum[a] += m_p * column_value(*v, i, a);
+    }
+    return true;
+  }
+};
+
+/// The mass and momentum budget of a run: the first frame against the last one plus the
+/// particles that left the domain before it (ESCP records).
+struct Budget {
+  bool valid = true;  ///< every frame and ESCP record had m and v
+  bool any = false;   ///< a frame was seen
+  Sums initial, domain, escaped_now, escaped;
+  double t0 = 0, t = 0;
+  void frame(const Frame& f) {
+    Sums s;
+    valid = s.add(f) && valid;
+    if (!any) initial = s, t0 = f.time;
+    any = true;
+    domain = s;
+    t = f.time;
+    escaped = escaped_now;
+  }
+  void escapes(const Frame& f) { valid = escaped_now.add(f) && valid; }
+};
 
 /// What summary reports of a stream.
 struct StreamContents {
@@ -28,7 +68,72 @@ struct StreamContents {
   std::vector<FrameEntry> frames;
   std::size_t hist_rows = 0;
   std::vector<std::string> hist_names;
+  Budget budget;
+  double factor = 1;      ///< extensive values per model unit to whole bodies
+  bool external = false;  ///< faces, loads, gravity or rigid bodies change the momentum
 };
+
+void print_budget_json(JsonWriter& j, const StreamContents& c) {
+  const Budget& b = c.budget;
+  auto sums = [&](const char* name, const Sums& s) {
+    j.key(name).begin_object().key("particles").integer(s.n).key("mass").number(c.factor * s.mass);
+    j.key("momentum")
+        .numbers({c.factor * s.momentum[0], c.factor * s.momentum[1], c.factor * s.momentum[2]});
+    j.end_object();
+  };
+  j.key("budget").begin_object().key("time").number(b.t);
+  sums("initial", b.initial);
+  sums("domain", b.domain);
+  sums("escaped", b.escaped);
+  const Vec3 dp = c.factor * (b.domain.momentum + b.escaped.momentum - b.initial.momentum);
+  j.key("mass_error").number(c.factor * (b.domain.mass + b.escaped.mass - b.initial.mass));
+  j.key("momentum_error").numbers({dp[0], dp[1], dp[2]});
+  j.key("external_forces").boolean(c.external).end_object();
+}
+
+void print_budget_text(const StreamContents& c) {
+  const Budget& b = c.budget;
+  if (!b.any) return;
+  if (!b.valid) {
+    std::printf("budget: the frames lack the m or v column (output.fields)\n");
+    return;
+  }
+  const double k = c.factor;
+  std::printf("budget (mass and momentum: in the domain + escaped = initial):\n");
+  std::printf("  %-30s %10s %14s %14s %14s %14s\n", "", "particles", "mass kg", "p_x kg m/s",
+              "p_y kg m/s", "p_z kg m/s");
+  auto row = [&](const std::string& what, const Sums& s) {
+    std::printf("  %-30s %10zu %14.8g %14.8g %14.8g %14.8g\n", what.c_str(), s.n, k * s.mass,
+                k * s.momentum[0], k * s.momentum[1], k * s.momentum[2]);
+  };
+  char at[64];
+  std::snprintf(at, sizeof at, "initial (t = %.4g us)", b.t0 * 1e6);
+  row(at, b.initial);
+  std::snprintf(at, sizeof at, "in the domain (t = %.4g us)", b.t * 1e6);
+  row(at, b.domain);
+  row("escaped by then", b.escaped);
+  const double dm = b.domain.mass + b.escaped.mass - b.initial.mass;
+  const Vec3 dp = b.domain.momentum + b.escaped.momentum - b.initial.momentum;
+  const double p_scale = std::max(b.initial.momentum.norm(), 1e-300);
+  std::printf("  %-30s %10lld %14.3g %14.3g %14.3g %14.3g\n", "domain + escaped - initial",
+              (long long)(b.domain.n + b.escaped.n) - (long long)b.initial.n, k * dm, k * dp[0],
+              k * dp[1], k * dp[2]);
+  std::printf("  relative: mass %.3g, momentum %.3g of |initial momentum|%s\n",
+              dm / std::max(b.initial.mass, 1e-300), dp.norm() / p_scale,
+              c.external ? " (boundary faces, loads, gravity or rigid bodies act on the material: "
+                           "their impulse is in the momentum difference)"
+                         : "");
+}
+
+/// Whether anything but the particles themselves changes their momentum.
+bool external_forces(const Scene& sc) {
+  for (int f = 0; f < 2 * sc.dimension; ++f)
+    if (sc.boundary.face[f] != BoundaryType::Free) return true;
+  for (const auto& b : sc.bodies)
+    if (b.rigid) return true;
+  return !sc.loads.empty() || sc.solver.gravity[0] != 0 || sc.solver.gravity[1] != 0 ||
+         sc.solver.gravity[2] != 0;
+}
 
 void print_summary_json(const std::string& path, const StreamContents& c, const StreamSummary& s) {
   JsonWriter j;
@@ -41,7 +146,9 @@ void print_summary_json(const std::string& path, const StreamContents& c, const 
   }
   j.end_array().key("history_rows").integer(c.hist_rows).key("ended").boolean(s.ended);
   j.key("status").integer(s.end_status).key("message").string(s.end_message);
-  j.key("damage").string(s.damage).end_object();
+  j.key("damage").string(s.damage);
+  if (c.budget.any && c.budget.valid) print_budget_json(j, c);
+  j.end_object();
   std::printf("%s\n", j.text().c_str());
 }
 
@@ -63,6 +170,7 @@ void print_summary_text(const std::string& path, const StreamContents& c, const 
   std::printf("\nend: %s\n",
               s.ended ? ("status " + std::to_string(s.end_status) + ", " + s.end_message).c_str()
                       : "missing (the producer stopped early or is still running)");
+  print_budget_text(c);
   if (!s.damage.empty()) std::printf("damage: %s\n", s.damage.c_str());
 }
 
@@ -109,7 +217,7 @@ std::vector<const Column*> particle_columns(const Frame& frame,
 }
 
 /// The CSV of particles: a comment with the time and step, a header, a row per particle.
-void write_particles_csv(std::FILE* f, const Frame& frame,
+void write_particles_csv(std::FILE* f, const std::string& path, const Frame& frame,
                          const std::vector<const Column*>& picked) {
   std::fprintf(f, "# t = %.10g s, step %lld\n", frame.time, (long long)frame.step);
   bool first = true;
@@ -128,6 +236,7 @@ void write_particles_csv(std::FILE* f, const Frame& frame,
         first = false;
       }
     std::fprintf(f, "\n");
+    check_written(f, path);
   }
 }
 
@@ -139,7 +248,11 @@ int post_summary(const SummaryArgs& a) {
   StreamContents c;
   StreamVisitor v;
   v.scene = [&](const std::string& t) { scene_text = t; };
-  v.frame = [&](Frame&& f) { c.frames.push_back({f.step, f.time, f.columns.size(), f.flags}); };
+  v.frame = [&](Frame&& f) {
+    c.frames.push_back({f.step, f.time, f.columns.size(), f.flags});
+    c.budget.frame(f);
+  };
+  v.escapes = [&](Frame&& f) { c.budget.escapes(f); };
   v.history = [&](HistoryBlock&& h) {
     c.hist_rows += h.rows();
     if (c.hist_names.empty()) c.hist_names = h.names;
@@ -149,6 +262,8 @@ int post_summary(const SummaryArgs& a) {
     const Scene sc = scene_of(scene_text, path);
     c.title = sc.title;
     c.dim = sc.dimension;
+    c.factor = sc.measure_factor();
+    c.external = external_forces(sc);
   }
   if (a.json)
     print_summary_json(path, c, s);
@@ -182,6 +297,7 @@ int post_history(const HistoryArgs& a) {
       for (std::size_t k = 0; k < pick.size(); ++k)
         std::fprintf(f, "%s%.10g", k ? "," : "", h.values[r * nc + pick[k]]);
       std::fprintf(f, "\n");
+      check_written(f, a.output);
     }
   };
   const StreamSummary s = read_stream(a.input, v);
@@ -210,7 +326,7 @@ int post_particles(const ParticlesArgs& a) {
   }
   const std::vector<const Column*> picked = particle_columns(*chosen, a.columns);
   std::FILE* f = open_output(a.output);
-  write_particles_csv(f, *chosen, picked);
+  write_particles_csv(f, a.output, *chosen, picked);
   close_output(f, a.output);
   return conclude(a.input, s, std::size_t(index));
 }

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <sstream>
 
@@ -13,8 +14,11 @@
 #include "mpm/core/version.hpp"
 #include "mpm/grid/lattice.hpp"
 #include "mpm/grid/sparse_grid.hpp"
+#include "mpm/prep/checks.hpp"
 #include "mpm/prep/graded_voxelise.hpp"
+#include "mpm/prep/initial_fields.hpp"
 #include "mpm/prep/region.hpp"
+#include "mpm/prep/resources.hpp"
 #include "mpm/prep/voxelise.hpp"
 #include "mpm/scene/particles.hpp"
 #include "mpm/solver/materials/material.hpp"
@@ -116,7 +120,7 @@ double grid_bytes(const Scene& scene, const Lattice& lattice, const ColumnStore&
   double nodes = 1;
   for (int a = 0; a < d; ++a) nodes *= std::floor((hi[a] - lo[a]) / lattice.h) + 4;
   if (graded) nodes = double(graded->nodes);  // the graded grid has no window
-  double bytes_grid = nodes * (8 + 3 * d * 8);
+  double bytes_grid = nodes * grid_node_bytes(d);
   if (scene.grid.sparse)
     bytes_grid = d == 3 ? sparse_grid_bytes<3>(scene, lattice, cols)
                         : sparse_grid_bytes<2>(scene, lattice, cols);
@@ -131,10 +135,7 @@ Estimates estimate_run(const Scene& scene, const Lattice& lattice, const ColumnS
   const double h_min = graded ? graded->h_min : lattice.h;  // the time step's cell
   e.dt = stable_time_step(scene.solver.dt_max, scene.solver.cfl, h_min, e.speed);
   e.steps = std::ceil(scene.solver.end_time / e.dt);
-  const ColumnNeeds need = column_needs(scene);
-  const int d = scene.dimension;
-  e.bytes_particle = 2 * d * 8 + 3 * 8 + 48 + 4 + 1 + 1 + (need.eps_p ? 8 : 0) + (need.T ? 8 : 0) +
-                     (need.failed ? 1 : 0) + (d == 2 && scene.plane_stress ? 8 : 0);  // thickness
+  e.bytes_particle = run_particle_bytes(scene);
   e.bytes_grid = grid_bytes(scene, lattice, cols, graded);
   return e;
 }
@@ -181,12 +182,46 @@ std::size_t print_bodies(const Scene& scene, const std::vector<BodyReport>& repo
         scene.bodies[b].rigid ? "(rigid)" : scene.materials[scene.bodies[b].material].name.c_str(),
         r.particles, mm(r.spacing).c_str(), r.mass, r.exact_mass,
         r.exact_mass > 0 ? 100.0 * (r.mass - r.exact_mass) / r.exact_mass : 0.0);
-    if (r.skipped_overlap > 0)
-      std::fprintf(stderr, "  (body '%s': %zu points inside earlier bodies were not created)\n",
-                   r.name.c_str(), r.skipped_overlap);
   }
   std::fprintf(stderr, "  %-14s %-12s %12zu\n", "total", "", total);
   return total;
+}
+
+/// Each material's wave speed and the step it alone would allow on the finest cells: a
+/// modulus or a density in the wrong unit shows here.
+void print_materials(const Scene& scene, double h_min) {
+  for (const MaterialSpec& spec : scene.materials) {
+    const double c = Material(spec, scene.solver).reference_wave_speed();
+    std::fprintf(stderr,
+                 "  material %-12s wave speed %.4g m/s (density %.4g kg/m^3, E %.4g GPa): "
+                 "step cfl h / c = %.4g ns\n",
+                 spec.name.c_str(), c, spec.density, spec.youngs_modulus / 1e9,
+                 scene.solver.cfl * h_min / c * 1e9);
+  }
+}
+
+/// Warnings for bodies that overlap earlier ones: the points of a body inside an earlier
+/// body are not created (earlier bodies win), so the later body loses that volume.
+void overlap_warnings(const Scene& scene, const std::vector<BodyReport>& report,
+                      std::vector<std::string>& warnings) {
+  const int d = scene.dimension;
+  for (std::size_t b = 0; b < report.size(); ++b) {
+    const BodyReport& r = report[b];
+    if (r.skipped_overlap == 0) continue;
+    const double lost = double(r.skipped_overlap) * std::pow(r.spacing, d);
+    char text[160];
+    std::snprintf(text, sizeof text, "%zu points (%.3g%% of the body, about %.4g %s) ",
+                  r.skipped_overlap,
+                  100.0 * double(r.skipped_overlap) / double(r.skipped_overlap + r.particles),
+                  lost * std::pow(1e3, d), d == 3 ? "mm^3" : "mm^2 of its section");
+    warnings.push_back("body '" + r.name + "' overlaps earlier bodies: " + text +
+                       "lie inside them and were not created (earlier bodies win)");
+  }
+}
+
+/// Prints warnings on stderr.
+void print_warnings(const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings) std::fprintf(stderr, "mpm-prep: warning: %s\n", w.c_str());
 }
 
 /// The summary's estimates of a run of `total` particles, and warnings.
@@ -246,24 +281,55 @@ void write_model(const PrepOptions& opt, const Scene& scene, const std::string& 
   out.close();
 }
 
+/// Voxelisation of every cell with progress lines on stderr once a body takes a while: every
+/// 2 s after the first 2 s, so small models print none.
+VoxeliseCells progress_cells(const Scene& scene) {
+  VoxeliseCells cells;
+  auto start = std::make_shared<double>(omp_get_wtime());
+  auto last = std::make_shared<double>(*start);
+  auto body = std::make_shared<std::size_t>(0);
+  cells.progress = [&scene, start, last, body](std::size_t b, double done) {
+    const double now = omp_get_wtime();
+    if (b != *body) *body = b, *start = now, *last = now;
+    if (now - *start < 2 || now - *last < 2) return;
+    *last = now;
+    std::fprintf(stderr, "mpm-prep: filling body '%s' with particles: %.0f%% (%.0f s)\n",
+                 scene.bodies[b].name.c_str(), 100 * done, now - *start);
+  };
+  return cells;
+}
+
 }  // namespace
 
 int prepare_model(const PrepOptions& opt) {
   const double t0 = omp_get_wtime();
   Scene scene = load_scene(opt.scene, opt.overrides);
-  const Lattice lattice = fit_lattice(scene);
+  std::vector<std::string> warnings = scene.warnings;
+  const BodyBoxes boxes = body_boxes(scene);
+  check_mesh_sizes(scene, boxes, warnings);
+  print_warnings(warnings);
+  const double limit = opt.max_memory > 0 ? opt.max_memory : machine_memory();
+  if (limit > 0) check_resources(scene, estimate_resources(scene, boxes), limit);
+  const Lattice lattice = fit_lattice(scene, boxes.lo, boxes.hi);
+  check_domain_cuts(scene, lattice, boxes);
   std::vector<BodyReport> report;
   std::optional<GradedModel> graded;  // scenes with grid levels (004, section 3.2)
   if (!scene.grid.levels.empty()) graded = prepare_graded(scene, lattice, report);
-  ColumnStore cols = graded ? std::move(graded->columns) : voxelise(scene, lattice, report);
+  ColumnStore cols =
+      graded ? std::move(graded->columns) : voxelise(scene, lattice, report, progress_cells(scene));
+  apply_initial_fields(scene, cols);  // spin, velocity and stress fields
   const GradedModel* graded_grid = graded ? &*graded : nullptr;
   const std::string text = with_explicit_domain(scene.toml, lattice);
   const Estimates estimates = estimate_run(scene, lattice, cols, graded_grid);
   if (!opt.quiet) {
     print_grid(scene, lattice, graded_grid);
     const std::size_t total = print_bodies(scene, report);
+    print_materials(scene, graded_grid ? graded_grid->h_min : lattice.h);
     print_estimates(scene, estimates, total);
   }
+  warnings.clear();
+  overlap_warnings(scene, report, warnings);
+  print_warnings(warnings);
   write_model(opt, scene, text, report, graded_grid, std::move(cols), t0);
   return kExitOk;
 }

@@ -11,6 +11,7 @@ struct PrepOptions {
   std::string output = "-";            ///< model stream, "-" for stdout
   std::vector<std::string> overrides;  ///< --set key=value
   bool quiet = false;                  ///< no summary on stderr
+  double max_memory = 0;  ///< bytes a model may need (--max-memory); 0: the machine's memory
 };
 
 /// Builds the model and writes it. Returns the exit status; throws InputError for bad input.

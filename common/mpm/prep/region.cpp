@@ -217,7 +217,8 @@ void check_body_shape(const BodySpec& body, const Scene& scene) {
   }
 }
 
-/// World bounding box of a body (reads mesh files but does not build their trees).
+}  // namespace
+
 void body_bounds(const BodySpec& body, const Scene& scene, Vec3& lo, Vec3& hi) {
   check_body_shape(body, scene);
   if (body.shape == ShapeKind::Mesh) {
@@ -227,8 +228,6 @@ void body_bounds(const BodySpec& body, const Scene& scene, Vec3& lo, Vec3& hi) {
   }
 }
 
-}  // namespace
-
 std::unique_ptr<Region> make_region(const BodySpec& body, const Scene& scene) {
   check_body_shape(body, scene);
   if (body.shape == ShapeKind::Mesh) return std::make_unique<MeshRegion>(body, scene);
@@ -236,6 +235,18 @@ std::unique_ptr<Region> make_region(const BodySpec& body, const Scene& scene) {
 }
 
 Lattice fit_lattice(const Scene& scene) {
+  if (scene.grid.domain_given) return make_lattice(scene);
+  std::vector<Vec3> lo, hi;
+  for (const BodySpec& b : scene.bodies) {
+    lo.emplace_back();
+    hi.emplace_back();
+    body_bounds(b, scene, lo.back(), hi.back());
+  }
+  return fit_lattice(scene, lo, hi);
+}
+
+Lattice fit_lattice(const Scene& scene, const std::vector<Vec3>& body_lo,
+                    const std::vector<Vec3>& body_hi) {
   const GridSpec& g = scene.grid;
   if (g.domain_given) return make_lattice(scene);
   check_lattice_scene(scene);
@@ -247,11 +258,9 @@ Lattice fit_lattice(const Scene& scene) {
                      "no domain is given and there is no body to fit one around");
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
   Vec3 hi = -lo;
-  for (const BodySpec& b : scene.bodies) {
-    Vec3 blo, bhi;
-    body_bounds(b, scene, blo, bhi);
-    lo = lo.cwiseMin(blo);
-    hi = hi.cwiseMax(bhi);
+  for (std::size_t b = 0; b < body_lo.size(); ++b) {
+    lo = lo.cwiseMin(body_lo[b]);
+    hi = hi.cwiseMax(body_hi[b]);
   }
   lo.array() -= g.padding;
   hi.array() += g.padding;

@@ -3,6 +3,7 @@
 /// primitives, or a closed mesh (mesh_region.hpp), and the lattice of a scene fitted around
 /// its bodies' regions.
 #include <memory>
+#include <vector>
 
 #include "mpm/core/types.hpp"
 #include "mpm/grid/lattice.hpp"
@@ -37,5 +38,12 @@ std::unique_ptr<Region> make_region(const BodySpec& body, const Scene& scene);
 /// corner rounded up to whole cells. Throws InputError as make_lattice does, when the padding is
 /// bad or there is no body, and for a body whose shape, placement or mesh file is bad.
 Lattice fit_lattice(const Scene& scene);
+/// fit_lattice around the bodies' bounding boxes [body_lo[b], body_hi[b]] (m) already known.
+Lattice fit_lattice(const Scene& scene, const std::vector<Vec3>& body_lo,
+                    const std::vector<Vec3>& body_hi);
+
+/// World bounding box of a body (m): reads mesh files but does not build their trees. Throws
+/// InputError for a bad shape or mesh file.
+void body_bounds(const BodySpec& body, const Scene& scene, Vec3& lo, Vec3& hi);
 
 }  // namespace mpm

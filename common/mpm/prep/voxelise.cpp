@@ -328,9 +328,16 @@ void count_body(BodyPlan& P, std::size_t b, const Lattice& lat, const VoxeliseCe
                 const BodyRegions& bodies) {
   const FirstPass pass(P, b, lat, cells, bodies);
   std::vector<std::uint64_t> row_kept(std::size_t(P.rows), 0), row_skipped(std::size_t(P.rows), 0);
+  // In about a hundred slices of rows, to report progress between them (rows are independent:
+  // the slices change nothing in the result).
+  const long long slice = cells.progress ? std::max(1LL, P.rows / 100) : std::max(1LL, P.rows);
+  for (long long r0 = 0; r0 < P.rows; r0 += slice) {
+    const long long r1 = std::min(P.rows, r0 + slice);
 #pragma omp parallel for schedule(dynamic, 8)
-  for (long long r = 0; r < P.rows; ++r)
-    pass.row(r, row_kept[std::size_t(r)], row_skipped[std::size_t(r)]);
+    for (long long r = r0; r < r1; ++r)
+      pass.row(r, row_kept[std::size_t(r)], row_skipped[std::size_t(r)]);
+    if (cells.progress) cells.progress(b, double(r1) / double(P.rows));
+  }
   P.row_start.assign(std::size_t(P.rows) + 1, 0);
   for (long long r = 0; r < P.rows; ++r) {
     P.row_start[std::size_t(r) + 1] = P.row_start[std::size_t(r)] + row_kept[std::size_t(r)];

@@ -31,6 +31,9 @@ struct VoxeliseCells {
   /// Keeps a cell (global index along x, y, z; z = 0 in 2D); empty: every cell.
   std::function<bool(const std::array<long long, 3>&)> keep;
   bool allow_empty = false;  ///< a body may get no particle in these cells
+  /// Called as the first pass goes through a body (its index, the share of its rows done),
+  /// about a hundred times a body, from the calling thread; empty: no progress.
+  std::function<void(std::size_t, double)> progress;
 };
 
 /// Particles of all bodies, in body order. Columns: id (u32), body (u8), material (u8),

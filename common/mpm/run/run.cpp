@@ -1,17 +1,23 @@
 #include "mpm/run/run.hpp"
 
 #include <omp.h>
+#include <toml++/toml.h>
 
 #include <atomic>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
+#include "mpm/core/cli.hpp"
 #include "mpm/core/error.hpp"
+#include "mpm/core/units.hpp"
 #include "mpm/core/version.hpp"
 #include "mpm/grid/lattice.hpp"
+#include "mpm/run/restart.hpp"
+#include "mpm/scene/particles.hpp"
 #include "mpm/solver/explicit/explicit_solver.hpp"
 #include "mpm/solver/explicit/graded_solver.hpp"
 #include "mpm/solver/explicit/sparse_solver.hpp"
@@ -26,6 +32,24 @@ const char* face_name(int face) {
 }
 
 namespace {
+
+/// The particles that left the domain since the last ESCP record (before the next frame or
+/// checkpoint), as an ESCP record stamped with the step and time (s); the log is emptied.
+void write_escapes(StreamWriter& out, EscapeLog& log, long step, double time) {
+  if (log.size() == 0) return;
+  Frame e;
+  e.step = step;
+  e.time = time;
+  std::swap(e.columns, log.columns());
+  try {
+    out.write_escapes(e);
+  } catch (...) {
+    std::swap(e.columns, log.columns());
+    throw;
+  }
+  std::swap(e.columns, log.columns());
+  log.clear();
+}
 
 /// Peak resident memory of this process (VmHWM), bytes; 0 when unknown.
 double peak_memory() {
@@ -47,13 +71,59 @@ struct Model {
   Frame frame;
 };
 
-Model read_model(const std::string& path) {
+/// Refuses, before the particles are read, a model whose run would need more than `limit`
+/// bytes: its particles (from mpm-prep's INFO record) times a run's bytes a particle and the
+/// model's, and a grid window of at most a node a particle and at most the domain.
+void check_model_memory(const std::string& name, const std::string& scene_text,
+                        const std::string& info, const RunOptions& opt) {
+  const double limit = opt.max_memory > 0 ? opt.max_memory : machine_memory();
+  if (!(limit > 0)) return;
+  double particles = 0;
+  try {
+    const toml::table t = toml::parse(info);
+    if (const auto* bodies = t["bodies"].as_array())
+      for (const auto& b : *bodies)
+        if (const auto* table = b.as_table()) particles += (*table)["particles"].value_or(0.0);
+  } catch (const toml::parse_error&) {
+    return;  // not mpm-prep's info: the frame's own checks apply
+  }
+  const Scene scene = parse_scene(scene_text, name + " (scene)", "", opt.overrides);
+  double nodes = 1;
+  if (scene.grid.domain_given) {
+    const Lattice lat = make_lattice(scene);
+    for (int a = 0; a < scene.dimension; ++a) nodes *= lat.cells[a] + 1.0;
+  }
+  const int d = scene.dimension;
+  const double model_bytes = 4 + 1 + 1 + 2 * d * 8 + 8 + 8;  // the model's columns as read
+  const double need = particles * (run_particle_bytes(scene) + model_bytes) +
+                      std::min(nodes, particles) * grid_node_bytes(d);
+  if (need > limit)
+    throw InputError(name, "the model holds " + format_count(particles) +
+                               " particles; running it would need about " + format_bytes(need) +
+                               " of memory, more than the limit of " + format_bytes(limit) +
+                               " (--max-memory; by default the machine's memory): run it on a "
+                               "larger machine, or make a coarser model with mpm-prep");
+}
+
+Model read_model(const RunOptions& opt) {
+  const std::string& path = opt.input;
   Model model;
   bool have_scene = false, have_frame = false;
   StreamVisitor v;
   v.scene = [&](const std::string& text) {
     model.scene_text = text;
     have_scene = true;
+  };
+  v.info = [&](const std::string& text) {
+    if (!have_frame && text.find("tool = \"mpm-run\"") != std::string::npos)
+      throw InputError(path == "-" ? "stdin" : path,
+                       "this is a result from mpm-run, not a model: to continue it from its "
+                       "last checkpoint use mpm-run --restart " +
+                           path +
+                           "; to run again from t = 0, run mpm-run on the model from "
+                           "mpm-prep");
+    if (have_scene && !have_frame)
+      check_model_memory(path == "-" ? "stdin" : path, model.scene_text, text, opt);
   };
   v.frame = [&](Frame&& f) {
     if (!have_frame) model.frame = std::move(f), have_frame = true;
@@ -96,6 +166,12 @@ class History {
     const char* axes[3] = {"momentum_x", "momentum_y", "momentum_z"};
     for (int a = 0; a < dim; ++a) add(axes[a], "kg m/s");
     add("particles", "-");
+    if (scene.solver.on_exit == OnExit::Remove) {  // what left, so that the totals close
+      removed_ = true;
+      add("removed_mass", "kg");
+      const char* out[3] = {"removed_momentum_x", "removed_momentum_y", "removed_momentum_z"};
+      for (int a = 0; a < dim; ++a) add(out[a], "kg m/s");
+    }
     for (int f = 0; f < 2 * dim; ++f)
       if (bc.face[f] != BoundaryType::Free) {
         faces_.push_back(f);
@@ -125,6 +201,8 @@ class History {
   }
   template <class Solver>
   void record(const Solver& s, double dt) {
+    if (s.steps() == last_step_) return;  // one row per time
+    last_step_ = s.steps();
     const Balance& b = s.balance();
     // Extensive values as totals: per metre in plane strain, the whole ring in axisymmetry.
     const double k = factor_;
@@ -133,6 +211,10 @@ class History {
                                k * b.removed,     k * b.total(),  k * b.leapfrog_total};
     for (int a = 0; a < dim_; ++a) row.push_back(k * b.momentum[a]);
     row.push_back(double(const_cast<Solver&>(s).particles().size()));
+    if (removed_) {
+      row.push_back(k * b.removed_mass);
+      for (int a = 0; a < dim_; ++a) row.push_back(k * b.removed_momentum[a]);
+    }
     for (int f : faces_) row.push_back(factor_ * s.face_force()[f]);
     for (int b : rigid_)
       for (int a = 0; a < dim_; ++a) row.push_back(factor_ * s.rigid_force()[b][a]);
@@ -166,7 +248,9 @@ class History {
   int dim_;
   double factor_;
   bool implicit_;
-  ImplicitWork last_;  ///< totals at the previous row
+  ImplicitWork last_;     ///< totals at the previous row
+  long last_step_ = -1;   ///< step of the last row
+  bool removed_ = false;  ///< columns of what left the domain (solver.on_exit = "remove")
   std::vector<int> faces_, rigid_;
   HistoryBlock block_;
 };
@@ -244,126 +328,255 @@ void print_stats(Solver& solver, int threads, double loop_wall) {
   }
 }
 
+/// A result stream continued from its last checkpoint (mpm-run --restart).
+struct Restart {
+  RestartScan scan;
+  Checkpoint checkpoint;
+};
+
+/// True for a solver whose state a checkpoint holds: the explicit solver on a uniform or
+/// sparse grid (the graded grid's window and the implicit solver's state are not saved yet).
 template <class Solver>
-int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Solver& solver) {
-  constexpr bool implicit = HasImplicitWork<Solver>;
-  using GridT = std::remove_cvref_t<decltype(solver.grid())>;
-  const int threads = omp_get_max_threads();
-  StreamWriter out(opt.output);
-  out.write_text(RecordType::Scene, scene.toml);
-  out.write_text(RecordType::Info, run_info(scene, lattice, threads));
-  // Graded grids: a GRID record at the start and whenever the grid was rebuilt.
-  long grid_revision = -1;
-  auto emit_grid = [&]() {
-    if constexpr (GridT::kGraded) {
-      if (solver.grid().revision() == grid_revision) return;
-      grid_revision = solver.grid().revision();
-      out.write_record(RecordType::Grid,
-                       encode_grid(solver.grid().mesh(solver.steps(), solver.time())));
+constexpr bool kCheckpoints = requires(const Solver& s, StateValues& v) {
+  s.save_state(v);
+}
+&&!HasImplicitWork<Solver> &&
+    !std::remove_cvref_t<decltype(std::declval<Solver&>().grid())>::kGraded;
+
+/// Steps a stop by SIGINT or SIGTERM waits for the particles' next re-sort, so that the
+/// checkpoint it writes continues the run bitwise (CheckpointClock::kMaxWait for the same).
+constexpr int kSignalWait = 20;
+
+/// The time loop of mpm-run: steps the solver to the end time, writes frames, history rows
+/// and checkpoints to the result stream, and stops cleanly on SIGINT or SIGTERM.
+template <class Solver>
+class TimeLoop {
+  static constexpr bool kImplicit = HasImplicitWork<Solver>;
+  using GridT = std::remove_cvref_t<decltype(std::declval<Solver&>().grid())>;
+
+ public:
+  TimeLoop(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Solver& solver,
+           const Restart* restart)
+      : opt_(opt),
+        o_(scene.output),
+        end_(scene.solver.end_time),
+        solver_(solver),
+        restart_(restart),
+        history_(Solver::D, scene, kImplicit),
+        checkpoint_(scene.output, solver.time()),
+        t_output_(solver.timers().id("output")) {
+    if (restart) {
+      out_ = std::make_unique<StreamWriter>(opt.output, opt.restart, restart->scan.keep);
+      const StateValues& s = restart->checkpoint.state;
+      frame_ = int(s.get("frame"));
+      next_history_ = s.get("next_history");
+      checkpoint_.restore(s);
+    } else {
+      out_ = std::make_unique<StreamWriter>(opt.output);
+      out_->write_text(RecordType::Scene, scene.toml);
+      out_->write_text(RecordType::Info, run_info(scene, lattice, omp_get_max_threads()));
+      next_history_ = o_.history_interval;
     }
-  };
-  emit_grid();
+  }
 
-  const OutputSpec& o = scene.output;
-  const double end = scene.solver.end_time;
-  KernelTimers& timers = solver.timers();
-  const int t_output = timers.id("output");
+  int operator()();
 
-  History history(Solver::D, scene, implicit);
-  auto emit_frame = [&](std::uint32_t flags) {
-    ScopedTimer timer(timers, t_output);
-    history.flush(out);
-    emit_grid();
+ private:
+  double next_frame() const { return frame_ <= o_.frames ? end_ * frame_ / o_.frames : end_; }
+  /// Graded grids: a GRID record at the start and whenever the grid was rebuilt.
+  void emit_grid() {
+    if constexpr (GridT::kGraded) {
+      if (solver_.grid().revision() == grid_revision_) return;
+      grid_revision_ = solver_.grid().revision();
+      out_->write_record(RecordType::Grid,
+                         encode_grid(solver_.grid().mesh(solver_.steps(), solver_.time())));
+    }
+  }
+  /// The particles as a frame, or in a checkpoint, written without copying them.
+  template <class Write>
+  void write_particles(std::uint32_t flags, Write&& write) {
     Frame f;
-    f.step = solver.steps();
-    f.time = solver.time();
+    f.step = solver_.steps();
+    f.time = solver_.time();
     f.flags = flags;
-    std::swap(f.columns, solver.particles());
+    std::swap(f.columns, solver_.particles());
     try {
-      out.write_frame(f, o.fields, o.precision);
+      write(f);
     } catch (...) {
-      std::swap(f.columns, solver.particles());
+      std::swap(f.columns, solver_.particles());
       throw;
     }
-    std::swap(f.columns, solver.particles());
-  };
+    std::swap(f.columns, solver_.particles());
+  }
+  void emit_frame(std::uint32_t flags) {
+    ScopedTimer timer(solver_.timers(), t_output_);
+    history_.flush(*out_);
+    write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
+    emit_grid();
+    write_particles(flags, [&](const Frame& f) { out_->write_frame(f, o_.fields, o_.precision); });
+  }
+  /// A CHKP record: the particles in cell order (settle) with the state the columns do not
+  /// hold; the history rows before it are flushed first, so the stream up to it is complete.
+  void write_checkpoint() {
+    if constexpr (kCheckpoints<Solver>) {
+      ScopedTimer timer(solver_.timers(), t_output_);
+      solver_.settle();
+      history_.flush(*out_);
+      write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
+      StateValues s;
+      solver_.save_state(s);
+      s.set("frame", frame_);
+      s.set("next_history", next_history_);
+      checkpoint_.save(s);
+      write_particles(0, [&](const Frame& f) { out_->write_checkpoint(s, f); });
+      checkpoint_.written();
+    }
+  }
+  /// Whether to stop for a signal now: at once without checkpoints; with them once the
+  /// particles are due for a re-sort (at most kSignalWait steps on), after a checkpoint.
+  bool stop_for_signal() {
+    if (!g_signal) return false;
+    if constexpr (kCheckpoints<Solver>) {
+      if (!solver_.sort_pending() && ++signal_wait_ <= kSignalWait) return false;
+      write_checkpoint();
+    }
+    status_ = 128 + g_signal;
+    message_ = "interrupted by signal " + std::to_string(int(g_signal)) +
+               " at t = " + std::to_string(solver_.time()) + " s; the last frame is the state then";
+    if constexpr (kCheckpoints<Solver>)
+      message_ += opt_.output == "-"
+                      ? "; the stream holds a checkpoint of it: saved to a file, it continues "
+                        "with mpm-run --restart FILE"
+                      : "; continue with: mpm-run --restart " + opt_.output;
+    return true;
+  }
+  /// One step and what follows it: history rows, frames, checkpoints.
+  void advance();
+  void report(double loop_wall) const;
 
+  const RunOptions& opt_;
+  const OutputSpec& o_;
+  const double end_;
+  Solver& solver_;
+  const Restart* restart_;
+  std::unique_ptr<StreamWriter> out_;
+  History history_;
+  CheckpointClock checkpoint_;
+  int t_output_;
+  long grid_revision_ = -1;
+  int frame_ = 1;  ///< index of the next frame; frame k is at end_time k / frames
+  double next_history_ = 0;
+  int signal_wait_ = 0;
+  int status_ = kExitOk;
+  std::string message_;
+};
+
+template <class Solver>
+void TimeLoop<Solver>::advance() {
+  const double pace = solver_.stable_dt();  // the step taken when no frame time is near
+  double dt = next_step(solver_, next_frame());
+  if constexpr (kImplicit)
+    solver_.step(dt);
+  else
+    solver_.step(dt, pace);  // the leapfrog energy evaluated at the pace, not the cut step
+  if constexpr (kImplicit) dt = solver_.last_dt();  // cut when Newton failed
+  if (solver_.time() >= next_history_ * (1 - 1e-12) || o_.history_interval <= 0) {
+    history_.record(solver_, dt);
+    next_history_ += o_.history_interval;
+    if (history_.pending() >= 4096) history_.flush(*out_);
+  }
+  if (solver_.time() >= next_frame() * (1 - 1e-12)) {
+    history_.record(solver_, dt);  // a row at each frame time (one: record skips a repeat)
+    emit_frame(frame_ == o_.frames ? std::uint32_t(kFrameFinal) : 0u);
+    ++frame_;
+  }
+  if constexpr (kCheckpoints<Solver>) {
+    checkpoint_.tick(solver_.time());
+    if (solver_.time() < end_ * (1 - 1e-12) && checkpoint_.write_now(solver_.sort_pending()))
+      write_checkpoint();
+  }
+}
+
+template <class Solver>
+int TimeLoop<Solver>::operator()() {
+  if (!restart_) {
+    emit_grid();
+    history_.record(solver_, 0.0);
+    emit_frame(0);
+  }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  history.record(solver, 0.0);
-  emit_frame(0);
-
-  Progress progress(opt.progress, end);
-  int frame = 1;
-  double next_frame = end * frame / o.frames;
-  double next_history = o.history_interval;
-  int status = kExitOk;
-  std::string message;
-  const long max_steps = scene.solver.max_steps;
+  Progress progress(opt_.progress, end_);
+  const long max_steps = solver_.scene().solver.max_steps;
   const double loop_start = omp_get_wtime();
   try {
-    while (solver.time() < end * (1 - 1e-12)) {
-      if (g_signal) {
-        status = 128 + g_signal;
-        message = "interrupted by signal " + std::to_string(int(g_signal)) +
-                  " at t = " + std::to_string(solver.time()) +
-                  " s; the last frame is the state then";
+    while (solver_.time() < end_ * (1 - 1e-12)) {
+      if (stop_for_signal()) break;
+      if (max_steps > 0 && solver_.steps() >= max_steps) {
+        message_ = "stopped at solver.max_steps = " + std::to_string(max_steps);
         break;
       }
-      if (max_steps > 0 && solver.steps() >= max_steps) {
-        message = "stopped at solver.max_steps = " + std::to_string(max_steps);
-        break;
-      }
-      double dt = next_step(solver, next_frame);
-      solver.step(dt);
-      if constexpr (implicit) dt = solver.last_dt();  // cut when Newton failed
-      if (solver.time() >= next_history * (1 - 1e-12) || o.history_interval <= 0) {
-        history.record(solver, dt);
-        next_history += o.history_interval;
-        if (history.pending() >= 4096) history.flush(out);
-      }
-      if (solver.time() >= next_frame * (1 - 1e-12)) {
-        if (history.pending() == 0 || o.history_interval > 0) history.record(solver, dt);
-        emit_frame(frame == o.frames ? std::uint32_t(kFrameFinal) : 0u);
-        ++frame;
-        next_frame = frame <= o.frames ? end * frame / o.frames : end;
-      }
-      progress.update(solver.time(), solver.steps());
+      advance();
+      progress.update(solver_.time(), solver_.steps());
     }
-    progress.done(solver.time(), solver.steps());
-    if (status != kExitOk || !message.empty()) {
-      history.record(solver, 0.0);
+    progress.done(solver_.time(), solver_.steps());
+    if (status_ != kExitOk || !message_.empty()) {
+      history_.record(solver_, 0.0);
       emit_frame(kFrameFinal);
     }
-    if (message.empty())
-      message = "completed " + std::to_string(solver.steps()) +
-                " steps to t = " + std::to_string(solver.time()) + " s";
+    if (message_.empty())
+      message_ = "completed " + std::to_string(solver_.steps()) +
+                 " steps to t = " + std::to_string(solver_.time()) + " s";
   } catch (const InstabilityError& e) {
-    progress.done(solver.time(), solver.steps());
-    status = kExitUnstable;
-    message = e.what();
+    progress.done(solver_.time(), solver_.steps());
+    status_ = kExitUnstable;
+    message_ = e.what();
   }
   const double loop_wall = omp_get_wtime() - loop_start;  // the time loop, output included
-  history.flush(out);
-  out.write_end(status, message);
-  out.close();
-  if (status == kExitUnstable) {
+  history_.flush(*out_);
+  write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
+  out_->write_end(status_, message_);
+  out_->close();
+  report(loop_wall);
+  return status_;
+}
+
+template <class Solver>
+void TimeLoop<Solver>::report(double loop_wall) const {
+  if (status_ == kExitUnstable) {
     std::fprintf(stderr,
                  "mpm-run: error: %s\nmpm-run: the %d frame(s) written before stay valid "
                  "(last at t = %g s)\n",
-                 message.c_str(), frame, frame > 1 ? end * (frame - 1) / o.frames : 0.0);
+                 message_.c_str(), frame_, frame_ > 1 ? end_ * (frame_ - 1) / o_.frames : 0.0);
   } else {
-    std::fprintf(stderr, "mpm-run: %s\n", message.c_str());
+    std::fprintf(stderr, "mpm-run: %s\n", message_.c_str());
   }
-  if (solver.removed_particles() > 0)
+  if (solver_.removed_particles() > 0)
     std::fprintf(stderr, "mpm-run: %zu particles left the domain and were removed\n",
-                 solver.removed_particles());
-  if (opt.stats) print_stats(solver, threads, loop_wall);
-  return status;
+                 solver_.removed_particles());
+  if (opt_.stats) print_stats(solver_, omp_get_max_threads(), loop_wall);
+}
+
+template <class Solver>
+int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Solver& solver,
+               const Restart* restart) {
+  if constexpr (kCheckpoints<Solver>) {
+    if (restart) solver.restore_state(restart->checkpoint.state);
+  } else if (scene.output.checkpoint_time > 0 || scene.output.checkpoint_wall > 0) {
+    throw InputError("output.checkpoint",
+                     HasImplicitWork<Solver>
+                         ? "the implicit solver does not write checkpoints (its state is not "
+                           "saved yet); remove output.checkpoint"
+                         : "graded grids do not write checkpoints (the window of their levels is "
+                           "not saved yet); remove output.checkpoint");
+  }
+  TimeLoop<Solver> loop(opt, scene, lattice, solver, restart);
+  return loop();
 }
 
 template <int D>
-int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame& model) {
+int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame& model,
+        const Restart* restart) {
   const bool graded = !scene.grid.levels.empty();  // mesh grading (004, section 3)
   if (scene.solver.type == SolverType::Implicit) {
     if (graded)
@@ -376,7 +589,7 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
                        "grid.sparse or use solver.type = \"explicit\"");
     ImplicitSolver<UniformGrid<D>> solver(scene, UniformGrid<D>(lattice, scene.boundary),
                                           model.columns);
-    return run_solver(opt, scene, lattice, solver);
+    return run_solver(opt, scene, lattice, solver, restart);
   }
   const ScatterStrategy strategy = parse_strategy(opt.strategy, "--strategy");
   if (opt.deterministic && strategy != ScatterStrategy::Colored)
@@ -391,7 +604,7 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
                        "[[grid.levels]] (use colored, lr-slabs or array-expansion)");
     ExplicitSolver<GradedGrid<D>> solver(scene, GradedGrid<D>(lattice, scene), model.columns,
                                          strategy);
-    return run_solver(opt, scene, lattice, solver);
+    return run_solver(opt, scene, lattice, solver, restart);
   }
   if (scene.grid.sparse) {
     if (strategy == ScatterStrategy::Patch)
@@ -401,27 +614,63 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
                        "array-expansion");
     ExplicitSolver<SparseGrid<D>> solver(scene, SparseGrid<D>(lattice, scene.boundary),
                                          model.columns, strategy);
-    return run_solver(opt, scene, lattice, solver);
+    return run_solver(opt, scene, lattice, solver, restart);
   }
   UniformSolver<D> solver(scene, UniformGrid<D>(lattice, scene.boundary), model.columns, strategy);
-  return run_solver(opt, scene, lattice, solver);
+  return run_solver(opt, scene, lattice, solver, restart);
+}
+
+/// mpm-run --restart: the run of a result stream continued from its last intact checkpoint.
+int restart_model(const RunOptions& opt) {
+  if (!opt.overrides.empty())
+    throw InputError("--set",
+                     "a restart continues the run with the scene it started with; "
+                     "drop --set (or run the model again with it)");
+  Restart restart;
+  restart.scan = scan_for_restart(opt.restart);
+  const Scene scene = parse_scene(restart.scan.scene_text, opt.restart + " (scene)", "", {});
+  if (scene.solver.type == SolverType::Implicit)
+    throw InputError("--restart " + opt.restart,
+                     "runs of the implicit solver cannot be continued: its checkpoints are not "
+                     "written yet; run the model again");
+  if (!scene.grid.levels.empty())
+    throw InputError("--restart " + opt.restart,
+                     "runs on graded grids cannot be continued: their checkpoints are not "
+                     "written yet; run the model again");
+  check_restartable(opt.restart, restart.scan);
+  restart.checkpoint = load_checkpoint(opt.restart, restart.scan);
+  const RestartScan& s = restart.scan;
+  std::fprintf(stderr,
+               "mpm-run: continuing %s from its checkpoint at step %ld, t = %g s; the %zu "
+               "frame(s) before it are kept, the %llu bytes after it (%s) are recomputed\n",
+               opt.restart.c_str(), long(restart.checkpoint.frame.step),
+               restart.checkpoint.frame.time, s.frames_kept,
+               static_cast<unsigned long long>(s.size - s.keep),
+               !s.damage.empty() ? s.damage.c_str()
+               : s.ended         ? ("stopped: " + s.end_message).c_str()
+                                 : "cut at a record boundary");
+  const Lattice lattice = make_lattice(scene);
+  Frame& particles = restart.checkpoint.frame;
+  if (scene.dimension == 3) return run<3>(opt, scene, lattice, particles, &restart);
+  return run<2>(opt, scene, lattice, particles, &restart);
 }
 
 }  // namespace
 
 int run_model(const RunOptions& opt) {
   if (opt.threads > 0) omp_set_num_threads(opt.threads);
+  if (!opt.restart.empty()) return restart_model(opt);
   for (const auto& kv : opt.overrides)
     if (kv.rfind("bodies", 0) == 0)
       throw InputError("--set " + kv.substr(0, kv.find('=')),
                        "bodies are fixed once mpm-prep has made the particles; pass this "
                        "override to mpm-prep instead");
-  Model model = read_model(opt.input);
+  Model model = read_model(opt);
   const std::string name = (opt.input == "-" ? std::string("stdin") : opt.input) + " (scene)";
   const Scene scene = parse_scene(model.scene_text, name, "", opt.overrides);
   const Lattice lattice = make_lattice(scene);
-  if (scene.dimension == 3) return run<3>(opt, scene, lattice, model.frame);
-  return run<2>(opt, scene, lattice, model.frame);
+  if (scene.dimension == 3) return run<3>(opt, scene, lattice, model.frame, nullptr);
+  return run<2>(opt, scene, lattice, model.frame, nullptr);
 }
 
 }  // namespace mpm

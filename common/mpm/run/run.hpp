@@ -16,10 +16,13 @@ struct RunOptions {
   std::string strategy = "colored";    ///< particle-to-grid scatter strategy
   bool deterministic = false;          ///< results independent of the thread count
   ProgressMode progress = ProgressMode::Auto;
+  std::string restart;    ///< result stream to continue from its last checkpoint ("": none)
+  double max_memory = 0;  ///< bytes the run may need (--max-memory); 0: the machine's memory
 };
 
-/// Runs a model to its end time. Returns the exit status (ExitStatus); errors in the input
-/// throw InputError/StreamError, write failures IoError.
+/// Runs a model to its end time (or, with `restart`, continues a result stream from its last
+/// checkpoint: written to `output`, which may be that stream itself). Returns the exit status
+/// (ExitStatus); errors in the input throw InputError/StreamError, write failures IoError.
 int run_model(const RunOptions& options);
 
 /// Face names in BoundarySpec order: x_min, x_max, y_min, y_max, z_min, z_max.

@@ -131,4 +131,12 @@ ParticleView<D> view(ColumnStore& cols) {
 template ParticleView<2> view<2>(ColumnStore&);
 template ParticleView<3> view<3>(ColumnStore&);
 
+double run_particle_bytes(const Scene& scene) {
+  const ColumnNeeds need = column_needs(scene);
+  const int d = scene.dimension;
+  // x and v, m, rho and e, sigma, id, material and body, then the optional columns.
+  return 2 * d * 8 + 3 * 8 + 48 + 4 + 1 + 1 + (need.eps_p ? 8 : 0) + (need.T ? 8 : 0) +
+         (need.failed ? 1 : 0) + (d == 2 && scene.plane_stress ? 8 : 0);
+}
+
 }  // namespace mpm

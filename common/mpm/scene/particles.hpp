@@ -37,6 +37,12 @@ inline const std::string thickness =
 /// Material id of the particles of rigid bodies (they have no material).
 inline constexpr std::uint8_t kRigidMaterial = 255;
 
+/// The body of element i of a body column: u8, or u32 in models of more than 255 bodies.
+inline std::uint32_t body_id(const Column& body, std::size_t i) {
+  return body.info().type == ScalarType::U8 ? std::uint32_t(body.as<std::uint8_t>()[i])
+                                            : body.as<std::uint32_t>()[i];
+}
+
 /// Raw pointers into the particle columns for the kernels; optional columns are nullptr when
 /// absent. Valid until the columns are resized or reordered.
 template <int D>
@@ -66,6 +72,15 @@ struct ColumnNeeds {
   bool failed = false;
 };
 ColumnNeeds column_needs(const Scene& scene);
+
+/// Bytes of one particle in a run (the model's columns and the state columns of
+/// prepare_columns), for the estimates of mpm-prep and the memory check of mpm-run.
+double run_particle_bytes(const Scene& scene);
+
+/// Bytes of one node of the dense grid window: its mass and 3 vectors of d components.
+inline double grid_node_bytes(int dim) {
+  return 8 + 3 * dim * 8;
+}
 
 /// Adds the state columns a run needs to a model's columns (sigma, e and the optional ones),
 /// initialised to the unstressed state (T to each material's room temperature; thickness to 1

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "mpm/core/error.hpp"
+#include "mpm/core/expression.hpp"
 #include "mpm/scene/read_sections.hpp"
 
 namespace mpm::scene_toml {
@@ -41,7 +42,12 @@ const std::vector<std::string_view> kBodyKeys = {"name",
                                                  "particles_per_cell",
                                                  "particle_spacing",
                                                  "rigid",
-                                                 "slip"};
+                                                 "slip",
+                                                 "angular_velocity",
+                                                 "spin_centre",
+                                                 "velocity_field",
+                                                 "stress_field",
+                                                 "cut_by_domain"};
 
 /// The body's material, or none for a rigid body.
 void read_body_material(Reader& r, const Scene& scene, BodySpec& b) {
@@ -185,6 +191,84 @@ void read_slip(Reader& r, int n, BodySpec& b) {
   }
 }
 
+/// One formula of a field: a string (or a plain number) that compiles over field_variables();
+/// `sub` is "[1]" or ".xy", the component after the key.
+FieldExpression read_formula(Reader& r, std::string_view key, const std::string& sub,
+                             const toml::node& n) {
+  std::string text;
+  if (const auto* str = n.as_string())
+    text = str->get();
+  else if (n.is_integer() || n.is_floating_point())
+    text = format_number(n.value<double>().value());
+  else
+    r.fail(key,
+           "expected a formula of x, y, z, r as a string, e.g. \"0.5*cos(pi*x/0.1)\", " + got(n),
+           &n);
+  std::vector<double> values(field_variables().size(), 0.0);
+  try {
+    const Expression compiled(text, field_variables(), values.data());
+  } catch (const ExpressionError& e) {
+    r.fail(std::string(key) + sub,
+           describe(e, text) + " (variables: x y z r x_min x_max y_min y_max z_min z_max, in m)",
+           &n);
+  }
+  SourceLoc loc = r.loc_of(key);
+  loc.key += sub;
+  return {text, loc};
+}
+
+/// angular_velocity, spin_centre, velocity_field, stress_field (not for rigid bodies).
+void read_initial_fields(Reader& r, const Scene& scene, BodySpec& b) {
+  const int n = scene.dimension;
+  for (std::string_view key : {"angular_velocity", "spin_centre", "velocity_field", "stress_field"})
+    if (b.rigid && r.has(key))
+      r.fail(key, "a rigid body moves at its velocity for ever; it takes no spin or field");
+  if (const toml::node* w = r.get("angular_velocity")) {
+    if (w->is_string() && w->as_string()->get().find("Hz") != std::string::npos)
+      r.fail("angular_velocity",
+             "give the angular velocity in rad/s (or 1/s), not Hz (revolutions per second "
+             "are 2 pi rad/s), got " +
+                 show(*w));
+    if (scene.axisymmetric)
+      r.fail("angular_velocity",
+             "an axisymmetric scene cannot spin a body in its plane (x is the radius)");
+    if (n == 2)
+      b.angular_velocity = Vec3(0, 0, *r.quantity("angular_velocity", dim::rate));
+    else
+      b.angular_velocity = *r.vector("angular_velocity", dim::rate, 3);
+  }
+  if (auto c = r.vector("spin_centre", dim::length, n)) {
+    if (!r.has("angular_velocity"))
+      r.fail("spin_centre", "a spin centre needs an angular_velocity");
+    b.spin_centre = *c;
+    b.spin_centre_given = true;
+  }
+  if (const toml::node* f = r.get("velocity_field")) {
+    const auto* arr = f->as_array();
+    if (!arr || int(arr->size()) != n)
+      r.fail("velocity_field", "expected " + std::to_string(n) +
+                                   " formulas (one per axis, in m/s), e.g. [\"0.5*cos(pi*x/0.1)\"" +
+                                   (n == 3 ? ", 0, 0]" : ", 0]") + ", " + got(*f));
+    for (int a = 0; a < n; ++a)
+      b.velocity_field.push_back(
+          read_formula(r, "velocity_field", "[" + std::to_string(a) + "]", *arr->get(a)));
+  }
+  const std::vector<std::string_view> components =
+      n == 3 ? std::vector<std::string_view>{"xx", "yy", "zz", "yz", "xz", "xy"}
+             : std::vector<std::string_view>{"xx", "yy", "zz", "xy"};
+  if (auto t = r.table("stress_field", components)) {
+    if (scene.plane_stress && t->has("zz")) t->fail("zz", "a plane-stress sheet has sigma_zz = 0");
+    static const char* voigt[6] = {"xx", "yy", "zz", "yz", "xz", "xy"};
+    for (const char* c : voigt) {
+      const bool in_plane = std::find(components.begin(), components.end(), c) != components.end();
+      const toml::node* v = in_plane ? t->get(c) : nullptr;
+      b.stress_field.push_back(v ? read_formula(r, "stress_field", "." + std::string(c), *v)
+                                 : FieldExpression{"0", r.loc_of("stress_field")});
+    }
+    t->finish();
+  }
+}
+
 /// One [[bodies]] table.
 BodySpec read_body(Reader& r, const Scene& scene) {
   BodySpec b;
@@ -195,6 +279,8 @@ BodySpec read_body(Reader& r, const Scene& scene) {
   read_placement(r, scene.dimension, b);
   read_particles(r, b);
   read_slip(r, scene.dimension, b);
+  read_initial_fields(r, scene, b);
+  b.cut_by_domain = r.boolean("cut_by_domain").value_or(false);
   r.finish();
   return b;
 }

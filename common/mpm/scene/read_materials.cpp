@@ -2,6 +2,8 @@
 #include <initializer_list>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "mpm/core/error.hpp"
 #include "mpm/scene/read_sections.hpp"
@@ -64,14 +66,38 @@ void read_strength(Reader& r, StrengthSpec& s) {
   r.finish();
 }
 
+const std::initializer_list<std::string_view> kMieGruneisenKeys = {"c0", "s", "gamma0",
+                                                                   "energy_in_expansion"};
+const std::initializer_list<std::string_view> kTillotsonKeys = {
+    "a", "b", "A", "B", "E0", "E_iv", "E_cv", "alpha", "beta"};
+
+// Tillotson's constants, each required (docs/eos-tillotson.md derives lead's).
+void read_tillotson(Reader& r, TillotsonSpec& t) {
+  t.a = r.required("a", dim::none, Bound::NonNegative, "0.5");
+  t.b = r.required("b", dim::none, Bound::NonNegative, "1.63");
+  t.A = r.required("A", dim::pressure, Bound::Positive, "75.2 GPa");
+  t.B = r.required("B", dim::pressure, Bound::Any, "65 GPa");
+  t.E0 = r.required("E0", dim::specific_energy, Bound::Positive, "5 MJ/kg");
+  t.E_iv = r.required("E_iv", dim::specific_energy, Bound::NonNegative, "3 MJ/kg");
+  t.E_cv = r.required("E_cv", dim::specific_energy, Bound::Positive, "13.9 MJ/kg");
+  t.alpha = r.required("alpha", dim::none, Bound::NonNegative, "5");
+  t.beta = r.required("beta", dim::none, Bound::NonNegative, "5");
+  r.check("E_cv", t.E_cv > t.E_iv, "must be above E_iv (" + format_number(t.E_iv) + " J/kg)");
+}
+
 void read_eos(Reader& r, EosSpec& e) {
-  e.model = r.choice<EosModel>(
-                 "model", {{"linear", EosModel::Linear}, {"mie-gruneisen", EosModel::MieGruneisen}})
+  e.model = r.choice<EosModel>("model", {{"linear", EosModel::Linear},
+                                         {"mie-gruneisen", EosModel::MieGruneisen},
+                                         {"tillotson", EosModel::Tillotson}})
                 .value_or(EosModel::Linear);
   if (e.model == EosModel::Linear) {
-    r.reject({"c0", "s", "gamma0", "energy_in_expansion"},
-             "by the linear model (set model = \"mie-gruneisen\")");
+    r.reject(kMieGruneisenKeys, "by the linear model (set model = \"mie-gruneisen\")");
+    r.reject(kTillotsonKeys, "by the linear model (set model = \"tillotson\")");
+  } else if (e.model == EosModel::Tillotson) {
+    r.reject(kMieGruneisenKeys, "by the tillotson model (set model = \"mie-gruneisen\")");
+    read_tillotson(r, e.tillotson);
   } else {
+    r.reject(kTillotsonKeys, "by the mie-gruneisen model (set model = \"tillotson\")");
     e.c0 = r.required("c0", dim::velocity, Bound::Positive, "3940 m/s");
     e.s = r.required("s", dim::none, Bound::NonNegative, "1.49");
     e.gamma0 = r.required("gamma0", dim::none, Bound::NonNegative, "1.96");
@@ -89,7 +115,55 @@ void read_failure(Reader& r, FailureSpec& f) {
   r.finish();
 }
 
-MaterialSpec read_material(Reader& r, const std::string& name) {
+/// A value outside what any solid has: its plausible range (SI) and the units it was most
+/// likely meant in (tried in order).
+struct Plausible {
+  double lo, hi;                                      ///< SI
+  const char* range;                                  ///< the range as the warning prints it
+  const char* si;                                     ///< the SI unit
+  std::vector<std::pair<const char*, double>> units;  ///< unit and its factor to SI
+};
+
+/// Warns (into `warnings`) when v at `at` lies outside p's range, with the likely unit.
+void plausible(std::vector<std::string>& warnings, const SourceLoc& at, double v,
+               const Plausible& p) {
+  if (!(v > 0) || (v >= p.lo && v <= p.hi)) return;
+  std::string w = where(at.file, at.line, at.key) + ": " + format_number(v) + " " + p.si + " is " +
+                  (v < p.lo ? "below" : "above") + " what any solid has (" + p.range +
+                  "); plain numbers are SI";
+  for (const auto& [unit, factor] : p.units)
+    if (v * factor >= p.lo && v * factor <= p.hi) {
+      const std::string key = at.key.substr(at.key.rfind('.') + 1);
+      w += ": for " + format_number(v) + " " + unit + " write " + key + " = \"" + format_number(v) +
+           " " + unit + "\"";
+      break;
+    }
+  warnings.push_back(w);
+}
+
+/// Quantities far outside what any solid has (a modulus typed as 200 for 200 GPa, LS-DYNA's
+/// tonnes per mm^3): warnings naming the key and the likely unit.
+void check_plausible(const Reader& r, const MaterialSpec& m, const SourceLoc& yield_at,
+                     const SourceLoc& c0_at, std::vector<std::string>& warnings) {
+  plausible(warnings, r.loc_of("density"), m.density,
+            {1, 30000, "1 to 30 000 kg/m^3", "kg/m^3", {{"g/cm^3", 1e3}, {"Mg/mm^3", 1e12}}});
+  plausible(warnings, r.loc_of("youngs_modulus"), m.youngs_modulus,
+            {1e6, 1.2e12, "1 MPa to 1200 GPa", "Pa", {{"GPa", 1e9}, {"MPa", 1e6}}});
+  const StrengthSpec& s = m.strength;
+  if (s.model != StrengthModel::Elastic && s.A > m.youngs_modulus)
+    warnings.push_back(where(yield_at.file, yield_at.line, yield_at.key) + ": the yield stress " +
+                       format_number(s.A) + " Pa is above youngs_modulus (" +
+                       format_number(m.youngs_modulus) +
+                       " Pa); a yield stress is a small fraction of the modulus: check the "
+                       "units of both (plain numbers are SI, Pa)");
+  else if (s.model != StrengthModel::Elastic)
+    plausible(warnings, yield_at, s.A,
+              {1e3, 1e11, "1 kPa to 100 GPa", "Pa", {{"MPa", 1e6}, {"GPa", 1e9}}});
+  if (m.eos.model == EosModel::MieGruneisen)
+    plausible(warnings, c0_at, m.eos.c0, {100, 20000, "100 to 20 000 m/s", "m/s", {{"km/s", 1e3}}});
+}
+
+MaterialSpec read_material(Reader& r, const std::string& name, std::vector<std::string>& warnings) {
   MaterialSpec m;
   m.name = name;
   m.loc = r.loc();
@@ -99,15 +173,21 @@ MaterialSpec read_material(Reader& r, const std::string& name) {
   r.check("poisson_ratio", m.poisson_ratio > -1, "must be above -1");
   r.check("poisson_ratio", m.poisson_ratio < 0.5,
           "must be below 0.5 (incompressible materials are not supported)");
+  SourceLoc yield_at, c0_at;
   if (auto t = r.table("strength",
                        {"model", "A", "B", "n", "C", "reference_rate", "m", "room_temperature",
                         "melt_temperature", "specific_heat", "taylor_quinney"})) {
     read_strength(*t, m.strength);
+    yield_at = t->loc_of("A");
   }
-  if (auto t = r.table("eos", {"model", "c0", "s", "gamma0", "energy_in_expansion"}))
+  if (auto t = r.table("eos", {"model", "c0", "s", "gamma0", "energy_in_expansion", "a", "b", "A",
+                               "B", "E0", "E_iv", "E_cv", "alpha", "beta"})) {
     read_eos(*t, m.eos);
+    c0_at = t->loc_of("c0");
+  }
   if (auto t = r.table("failure", {"plastic_strain", "pressure"})) read_failure(*t, m.failure);
   r.finish();
+  check_plausible(r, m, yield_at, c0_at, warnings);
   return m;
 }
 
@@ -137,7 +217,7 @@ void read_materials(Reader& top, Scene& s) {
     }
     Reader r(doc, *t, path, o,
              {"density", "youngs_modulus", "poisson_ratio", "strength", "eos", "failure"});
-    s.materials.push_back(read_material(r, std::string(name.str())));
+    s.materials.push_back(read_material(r, std::string(name.str()), s.warnings));
   }
 }
 

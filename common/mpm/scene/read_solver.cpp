@@ -125,6 +125,16 @@ void read_output(Reader& r, Scene& s) {
   o.precision = r.choice<Precision>("precision", {{"float64", Precision::Float64},
                                                   {"float32", Precision::Float32}})
                     .value_or(Precision::Float64);
+  if (r.get("checkpoint")) {
+    auto t = r.table("checkpoint", {"time", "wall"});
+    o.checkpoint_time = t->quantity("time", dim::time, Bound::Positive).value_or(0.0);
+    o.checkpoint_wall = t->quantity("wall", dim::time, Bound::Positive).value_or(0.0);
+    t->finish();
+    if (o.checkpoint_time == 0 && o.checkpoint_wall == 0)
+      r.fail("checkpoint",
+             "expected the time between checkpoints: { time = \"10 us\" } of simulated time, "
+             "{ wall = \"1800 s\" } of wall-clock time, or both");
+  }
   r.finish();
 }
 

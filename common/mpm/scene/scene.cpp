@@ -90,7 +90,8 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
         "end_time is required");
     read_solver(v, s);
   }
-  if (auto o = top.table("output", {"frames", "history_interval", "fields", "precision"})) {
+  if (auto o = top.table("output",
+                         {"frames", "history_interval", "fields", "precision", "checkpoint"})) {
     read_output(*o, s);
   }
   if (s.axisymmetric) check_axisymmetric(s);
@@ -104,6 +105,12 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
 }
 
 }  // namespace
+
+const std::vector<std::string>& field_variables() {
+  static const std::vector<std::string> names = {"x",     "y",     "z",     "r",     "x_min",
+                                                 "x_max", "y_min", "y_max", "z_min", "z_max"};
+  return names;
+}
 
 int Scene::body_index(const std::string& name) const {
   for (std::size_t i = 0; i < bodies.size(); ++i) {

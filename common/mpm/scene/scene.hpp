@@ -19,7 +19,7 @@ struct SourceLoc {
 };
 
 enum class StrengthModel { Elastic, J2, JohnsonCook };
-enum class EosModel { Linear, MieGruneisen };
+enum class EosModel { Linear, MieGruneisen, Tillotson };
 
 /// Deviatoric strength. J2: sigma_y = A + B eps_p^n. Johnson-Cook multiplies by
 /// (1 + C ln(rate/rate0)) (1 - T*^m), T* = (T - T_room)/(T_melt - T_room).
@@ -38,7 +38,17 @@ struct StrengthSpec {
   bool thermal() const { return model == StrengthModel::JohnsonCook && m > 0; }
 };
 
+/// Tillotson's constants (docs/eos-tillotson.md); rho0 is the material's density.
+struct TillotsonSpec {
+  double a = 0, b = 0;         ///< thermal coefficients (a + b: Grueneisen's at rho0)
+  double A = 0, B = 0;         ///< linear and quadratic compression moduli, Pa
+  double E0 = 0;               ///< energy scale of omega = 1 + E / (E0 eta^2), J/kg
+  double E_iv = 0, E_cv = 0;   ///< incipient and complete vaporisation energies, J/kg
+  double alpha = 0, beta = 0;  ///< decay of the expanded branch's terms
+};
+
 /// Equation of state. Linear: p = K mu. Mie-Grueneisen (000, eq. 18) with internal energy.
+/// Tillotson: compressed, cold and hot expanded branches (docs/eos-tillotson.md).
 struct EosSpec {
   EosModel model = EosModel::Linear;
   double c0 = 0;      ///< bulk sound speed, m/s
@@ -47,6 +57,7 @@ struct EosSpec {
   /// Mie-Grueneisen in expansion (mu < 0): p = rho0 c0^2 mu + gamma0 E as 000 eq. 18 prints it
   /// (true), or without the energy term, as the seed authors' own code does (false).
   bool energy_in_expansion = true;
+  TillotsonSpec tillotson;  ///< model = Tillotson only
 };
 
 /// Failure: a failed particle keeps no deviatoric stress and carries no tension.
@@ -74,6 +85,17 @@ struct MaterialSpec {
 
 enum class ShapeKind { Box, Cylinder, Sphere, Mesh };
 
+/// A formula of position written in the scene (a body's velocity_field or stress_field), SI.
+/// Its variables are field_variables(); "0" stands for an absent component.
+struct FieldExpression {
+  std::string text;
+  SourceLoc loc;  ///< the key, e.g. "bodies.bar.velocity_field[0]"
+};
+/// The variables of field expressions, in the order prep binds them: x, y, z (m; z = 0 in 2D),
+/// r (m, the distance from the centre of the body's bounding box), and that box, x_min, x_max,
+/// y_min, y_max, z_min, z_max (m).
+const std::vector<std::string>& field_variables();
+
 /// A body: a shape in its local frame, placed by scale, then rotation, then translation.
 /// Local frames: box centred on the origin; cylinder along +z from z = 0 to z = length,
 /// axis through the origin; sphere centred on the origin; mesh as in its file.
@@ -99,10 +121,23 @@ struct BodySpec {
   double spacing(double h) const {
     return particle_spacing > 0 ? particle_spacing : h / particles_per_cell;
   }
+  /// Initial spin and fields (docs/scene.md, initial fields): the particle at x starts at
+  /// velocity + angular_velocity x (x - spin_centre) + velocity_field(x), stress stress_field(x).
+  Vec3 angular_velocity = Vec3::Zero();         ///< rad/s (2D: z only)
+  bool spin_centre_given = false;               ///< else the centre of the body's bounding box
+  Vec3 spin_centre = Vec3::Zero();              ///< m
+  std::vector<FieldExpression> velocity_field;  ///< one per axis, m/s; empty: none
+  std::vector<FieldExpression> stress_field;    ///< xx yy zz yz xz xy (Voigt), Pa; empty: none
+  bool has_initial_fields() const {
+    return !angular_velocity.isZero(0) || !velocity_field.empty() || !stress_field.empty();
+  }
   bool rigid = false;  ///< moves at `velocity` whatever happens
   /// Rigid bodies: bit a set = the contact is frictionless along axis a (the nodes the body
   /// touches keep the material's velocity in that component); 0 = no-slip (all components).
   std::uint8_t slip_axes = 0;
+  /// The domain may cut the body (its part outside gets no particles); else mpm-prep refuses a
+  /// body the domain cuts anywhere but at a symmetry plane.
+  bool cut_by_domain = false;
   SourceLoc loc;
 };
 
@@ -234,6 +269,8 @@ struct OutputSpec {
   double history_interval = 0;      ///< s; 0: every step
   std::vector<std::string> fields;  ///< particle columns written in frames; empty: all
   Precision precision = Precision::Float64;
+  double checkpoint_time = 0;  ///< s of simulated time between checkpoints; 0: none
+  double checkpoint_wall = 0;  ///< s of wall-clock time between checkpoints; 0: none
 };
 
 struct Scene {
@@ -252,6 +289,9 @@ struct Scene {
   SolverSpec solver;
   OutputSpec output;
   std::string toml;  ///< the scene as TOML text after overrides, as stored in streams
+  /// Values that are valid but implausible ("file:line: key: what and the likely fix"), found
+  /// by the parser; mpm-prep prints them as warnings.
+  std::vector<std::string> warnings;
 
   /// Index of a material by name, -1 if absent.
   int material_index(const std::string& name) const;

@@ -17,12 +17,14 @@
 
 #include "mpm/core/columns.hpp"
 #include "mpm/core/error.hpp"
+#include "mpm/core/state_values.hpp"
 #include "mpm/core/timers.hpp"
 #include "mpm/grid/binning.hpp"
 #include "mpm/grid/grid.hpp"
 #include "mpm/scene/particles.hpp"
 #include "mpm/scene/scene.hpp"
 #include "mpm/solver/balance.hpp"
+#include "mpm/solver/escapes.hpp"
 #include "mpm/solver/materials/material.hpp"
 
 namespace mpm {
@@ -132,7 +134,24 @@ class SolverCore {
   const Binning& binning() const { return binning_; }
   KernelTimers& timers() { return timers_; }
   std::size_t removed_particles() const { return removed_count_; }
+  /// The particles removed at the domain since the log was last cleared (by the run, once it
+  /// wrote them).
+  EscapeLog& escapes() { return escapes_; }
   const Scene& scene() const { return scene_; }
+
+  /// True when the next step begins by re-sorting the particles (some left their cell's bin,
+  /// the grid window or the domain).
+  bool sort_pending() const { return need_sort_; }
+  /// Sorts the particles into cell order now: the sort the next step would begin with when
+  /// sort_pending() (the results stay bitwise the same), else an extra one (they change at
+  /// round-off). After it the particle columns determine the bins and the grid window, so the
+  /// columns and save_state() are the whole state: a checkpoint.
+  void settle() { sort_particles(); }
+  /// Writes the state between steps that the particle columns do not hold: the clock, the
+  /// balance, the energy guard's reference, the counters.
+  void save_state(StateValues& s) const;
+  /// Restores what save_state() wrote, on a solver built from the columns saved with it.
+  void restore_state(const StateValues& s);
 
  protected:
   /// Takes the particles (columns as written by mpm-prep; state columns are added) and a grid
@@ -188,6 +207,7 @@ class SolverCore {
   const std::uint8_t* material_ = nullptr;  ///< refreshed with every view
   std::vector<std::uint32_t> exits_;  ///< particles that left the domain, removed at next sort
   std::size_t removed_count_ = 0;
+  EscapeLog escapes_;  ///< what they were when they left
   Balance balance_;
   double total0_ = 0, energy_scale_ = 0;
   std::array<double, 6> face_force_{};
@@ -225,10 +245,50 @@ template <Grid GridT>
 void SolverCore<GridT>::sort_particles() {
   ScopedTimer timer(timers_, timers_.id("sort"));
   removed_count_ += account_exits<D>(particles_, exits_, balance_);
+  escapes_.add(particles_, exits_, time_);
   binning_.sort(particles_, grid_, exits_);
   exits_.clear();
   need_sort_ = false;
   material_ = view<D>(particles_).material;
+}
+
+template <Grid GridT>
+void SolverCore<GridT>::save_state(StateValues& s) const {
+  s.set("step", double(steps_));
+  s.set("time", time_);
+  s.set("particle_steps", particle_steps_);
+  s.set("removed_particles", double(removed_count_));
+  s.set("kinetic", balance_.kinetic);
+  s.set("internal", balance_.internal);
+  s.set("external_work", balance_.external_work);
+  s.set("removed", balance_.removed);
+  for (int a = 0; a < 3; ++a) s.set(std::string("momentum_") + "xyz"[a], balance_.momentum[a]);
+  s.set("leapfrog_total", balance_.leapfrog_total);
+  s.set("removed_mass", balance_.removed_mass);
+  for (int a = 0; a < 3; ++a)
+    s.set(std::string("removed_momentum_") + "xyz"[a], balance_.removed_momentum[a]);
+  s.set("total0", total0_);
+  s.set("energy_scale", energy_scale_);
+}
+
+template <Grid GridT>
+void SolverCore<GridT>::restore_state(const StateValues& s) {
+  steps_ = long(s.get("step"));
+  time_ = s.get("time");
+  particle_steps_ = s.get("particle_steps");
+  removed_count_ = std::size_t(s.get("removed_particles"));
+  balance_.kinetic = s.get("kinetic");
+  balance_.internal = s.get("internal");
+  balance_.external_work = s.get("external_work");
+  balance_.removed = s.get("removed");
+  for (int a = 0; a < 3; ++a) balance_.momentum[a] = s.get(std::string("momentum_") + "xyz"[a]);
+  balance_.leapfrog_total = s.get("leapfrog_total");
+  auto optional = [&](const std::string& name) { return s.has(name) ? s.get(name) : 0.0; };
+  balance_.removed_mass = optional("removed_mass");  // absent from checkpoints of stream 1.2
+  for (int a = 0; a < 3; ++a)
+    balance_.removed_momentum[a] = optional(std::string("removed_momentum_") + "xyz"[a]);
+  total0_ = s.get("total0");
+  energy_scale_ = s.get("energy_scale");
 }
 
 template <Grid GridT>
@@ -288,6 +348,7 @@ void SolverCore<GridT>::reduce(const std::vector<ChunkSums>& chunks, ChunkSums& 
     total.kinetic += s.kinetic;
     total.leapfrog_kinetic += s.leapfrog_kinetic;
     total.work += s.work;
+    total.work_start += s.work_start;
     total.momentum += s.momentum;
     total.off_bin += s.off_bin;
     total.strays += s.strays;

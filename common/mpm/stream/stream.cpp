@@ -113,6 +113,8 @@ bool known_type(std::uint32_t type) {
     case RecordType::Frame:
     case RecordType::History:
     case RecordType::Grid:
+    case RecordType::Escape:
+    case RecordType::Checkpoint:
     case RecordType::End:
       return true;
   }
@@ -264,6 +266,15 @@ void StreamWriter::write_record(RecordType type, const std::vector<std::byte>& p
 
 void StreamWriter::write_frame(const Frame& frame, const std::vector<std::string>& fields,
                                Precision precision) {
+  write_columns(RecordType::Frame, {}, frame, fields, precision);
+}
+
+void StreamWriter::write_escapes(const Frame& escaped) {
+  write_columns(RecordType::Escape, {}, escaped, {}, Precision::Float64);
+}
+
+void StreamWriter::write_columns(RecordType type, const std::string& prefix, const Frame& frame,
+                                 const std::vector<std::string>& fields, Precision precision) {
   const ColumnStore& store = frame.columns;
   const std::size_t n = store.size();
   std::vector<OutColumn> out;
@@ -312,7 +323,8 @@ void StreamWriter::write_frame(const Frame& frame, const std::vector<std::string
     data_bytes += std::uint64_t(n) * info.components * scalar_size(o.type);
   }
 
-  begin_record(RecordType::Frame, head.b.size() + data_bytes);
+  begin_record(type, prefix.size() + head.b.size() + data_bytes);
+  put(prefix.data(), prefix.size());
   put(head.b.data(), head.b.size());
   std::vector<float> buf;
   for (const OutColumn& o : out) {
@@ -514,11 +526,16 @@ void StreamReader::skip() {
 }
 
 Frame StreamReader::read_frame() {
-  if (!pending_ || type_ != std::uint32_t(RecordType::Frame))
+  if (!pending_ ||
+      (type_ != std::uint32_t(RecordType::Frame) && type_ != std::uint32_t(RecordType::Escape)))
     throw std::logic_error("StreamReader::read_frame: the current record is not a frame");
-  if (length_ < kFrameFixedBytes) {
+  return read_frame_body();
+}
+
+Frame StreamReader::read_frame_body() {
+  if (length_ - done_ < kFrameFixedBytes) {
     fail_corrupt("a frame needs at least " + std::to_string(kFrameFixedBytes) + " bytes, it has " +
-                 std::to_string(length_));
+                 std::to_string(length_ - done_));
   }
   Frame frame;
   auto get = [&](auto& v) { read_exact(&v, sizeof v); };
@@ -680,6 +697,12 @@ StreamSummary read_stream(const std::string& path, const StreamVisitor& visitor)
           else
             r.skip();
           break;
+        case RecordType::Escape:
+          if (visitor.escapes)
+            frame = r.read_frame();
+          else
+            r.skip();
+          break;
         default:
           r.skip();  // a record type of a later minor version
       }
@@ -705,12 +728,17 @@ StreamSummary read_stream(const std::string& path, const StreamVisitor& visitor)
       case RecordType::Grid:
         if (visitor.grid) visitor.grid(std::move(grid));
         break;
+      case RecordType::Escape:
+        if (visitor.escapes) visitor.escapes(std::move(frame));
+        break;
       case RecordType::End:
         s.ended = true;
         s.end_status = end.first;
         s.end_message = end.second;
         if (visitor.end) visitor.end(end.first, end.second);
         return s;  // ENDS is the last record; anything after it is ignored
+      case RecordType::Checkpoint:
+        break;  // read by mpm-run --restart only (restart.hpp)
     }
   }
   return s;

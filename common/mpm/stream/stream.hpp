@@ -12,11 +12,13 @@
 #include <vector>
 
 #include "mpm/core/columns.hpp"
+#include "mpm/core/state_values.hpp"
 
 namespace mpm {
 
 inline constexpr std::uint16_t kStreamVersionMajor = 1;  ///< readers refuse other majors
-inline constexpr std::uint16_t kStreamVersionMinor = 1;  ///< readers accept any minor (1: GRID)
+/// Readers accept any minor (1: GRID; 2: CHKP; 3: ESCP).
+inline constexpr std::uint16_t kStreamVersionMinor = 3;
 
 /// Record types (little-endian fourcc).
 enum class RecordType : std::uint32_t {
@@ -26,6 +28,8 @@ enum class RecordType : std::uint32_t {
   History = 0x54534948,  ///< "HIST": rows of scalar time histories
   End = 0x53444E45,      ///< "ENDS": status and message; absent when the writer was killed
   Grid = 0x44495247,     ///< "GRID": a graded grid's nodes and cells (since 1.1; graded_grid.hpp)
+  Checkpoint = 0x504B4843,  ///< "CHKP": a solver's whole state, for mpm-run --restart (since 1.2)
+  Escape = 0x50435345,      ///< "ESCP": particles that left the domain, as a frame (since 1.3)
 };
 /// "SCEN", "FRAM", ... for messages; "?xyz" style hex for unknown codes.
 std::string record_name(std::uint32_t type);
@@ -44,6 +48,13 @@ struct Frame {
   ColumnStore columns;
 };
 
+/// A solver's whole state between two steps (a CHKP record): the named scalars and every
+/// particle column at full precision.
+struct Checkpoint {
+  StateValues state;
+  Frame frame;
+};
+
 /// A block of rows of a time history; every value is f64.
 struct HistoryBlock {
   std::vector<std::string> names;  ///< column names, e.g. "time", "dt", "kinetic"
@@ -58,6 +69,10 @@ class StreamWriter {
  public:
   /// Opens the file (or takes stdout for "-") and writes the 16-byte header; throws IoError.
   explicit StreamWriter(const std::string& path);
+  /// Continues the stream `source` after its first `keep` bytes (the header and whole
+  /// records): when `path` is that file (by any name), cuts it there and appends to it;
+  /// otherwise (another file, or "-") copies those bytes first. Throws IoError.
+  StreamWriter(const std::string& path, const std::string& source, std::uint64_t keep);
   /// Closes the file (errors are ignored here; call close() to see them). stdout stays open.
   ~StreamWriter();
   StreamWriter(const StreamWriter&) = delete;
@@ -69,6 +84,12 @@ class StreamWriter {
   /// Float32 precision stores f64 columns as f32, except "x" (positions keep f64).
   void write_frame(const Frame& frame, const std::vector<std::string>& fields = {},
                    Precision precision = Precision::Float64);
+  /// Writes an ESCP record: the particles that left the domain, every column in f64 (the
+  /// layout of a frame; docs/format.md).
+  void write_escapes(const Frame& escaped);
+  /// Writes a CHKP record: the state values, then every column of the frame as stored (f64
+  /// stays f64).
+  void write_checkpoint(const StateValues& state, const Frame& frame);
   /// Writes a record of binary payload (GRID: encode_grid in grid_record.hpp).
   void write_record(RecordType type, const std::vector<std::byte>& payload);
   /// Writes a HIST record (names and units must have the same size, values a multiple of it).
@@ -84,6 +105,9 @@ class StreamWriter {
   const std::string& path() const { return path_; }
 
  private:
+  /// Writes a FRAM, ESCP or CHKP record: `prefix` (CHKP's state values), then the frame.
+  void write_columns(RecordType type, const std::string& prefix, const Frame& frame,
+                     const std::vector<std::string>& fields, Precision precision);
   void begin_record(RecordType type, std::uint64_t length);
   void put(const void* data, std::size_t n);  ///< writes and updates the running CRC
   void end_record();
@@ -121,9 +145,11 @@ class StreamReader {
   bool next(std::uint32_t& type);
   /// The payload of the current record (checked against its CRC).
   std::vector<std::byte> read_payload();
-  /// The current record as a frame (must be a FRAM record), decoded straight into columns;
-  /// f32 columns are widened to f64. Checked against its CRC.
+  /// The current record as a frame (must be a FRAM or ESCP record), decoded straight into
+  /// columns; f32 columns are widened to f64. Checked against its CRC.
   Frame read_frame();
+  /// The current record as a checkpoint (must be a CHKP record). Checked against its CRC.
+  Checkpoint read_checkpoint();
   /// Skips the current record (still checks its CRC), reading in chunks (works on pipes).
   void skip();
 
@@ -149,6 +175,7 @@ class StreamReader {
 
  private:
   void read_exact(void* data, std::size_t n);  ///< payload bytes; updates the CRC
+  Frame read_frame_body();                     ///< a frame from the current payload position
   void finish_record();                        ///< reads and checks the CRC
   [[noreturn]] void fail(const std::string& message);
   [[noreturn]] void fail_truncated(const std::string& expected, std::uint64_t found);
@@ -177,6 +204,8 @@ struct StreamVisitor {
   std::function<void(int, const std::string&)> end;
   /// GRID payloads (decode_grid in grid_record.hpp); skipped when empty.
   std::function<void(std::vector<std::byte>&&)> grid;
+  /// ESCP records: particles that left the domain, as a frame (since 1.2); skipped when empty.
+  std::function<void(Frame&&)> escapes;
   bool want_frames = true;  ///< false: frames are skipped without decoding
 };
 

@@ -1,5 +1,6 @@
 // Off-screen pictures of frames: particles as shaded discs coloured by a field, a colour
-// bar and a title, through an orthographic camera fitted to the particles.
+// bar, a title, a scale bar and the view direction, through an orthographic camera fitted to
+// the particles (the whole body of a quarter or half model, cut by a section when asked).
 #include <vtkActor.h>
 #include <vtkCamera.h>
 #include <vtkExecutive.h>
@@ -31,6 +32,7 @@
 #include "mpm/core/error.hpp"
 #include "mpm/post/vtk/frame_columns.hpp"
 #include "mpm/post/vtk/render_fields.hpp"
+#include "mpm/post/vtk/render_view.hpp"
 #include "mpm/post/vtk/vtk_files.hpp"
 #include "mpm/post/vtk/vtk_output.hpp"
 #include "mpm/post/vtk/x_display.hpp"
@@ -82,27 +84,10 @@ Clip parse_clip(const std::string& text, int dim) {
   return c;
 }
 
-/// Camera direction of projection and view-up of a named view.
-void view_vectors(const std::string& view, int dim, std::array<double, 3>& dir,
-                  std::array<double, 3>& up) {
-  if (dim == 2) {  // the picture plane is the model plane whatever the view
-    dir = {0, 0, -1}, up = {0, 1, 0};
-    return;
-  }
-  const double r3 = 1.0 / std::sqrt(3.0);
-  if (view == "side")
-    dir = {0, -1, 0}, up = {0, 0, 1};
-  else if (view == "front")
-    dir = {-1, 0, 0}, up = {0, 0, 1};
-  else if (view == "top")
-    dir = {0, 0, -1}, up = {0, 1, 0};
-  else if (view == "iso")
-    dir = {-r3, -r3, -r3}, up = {0, 0, 1};
-}
-
 void check_view(const std::string& view) {
-  if (view != "side" && view != "front" && view != "top" && view != "iso")
-    throw InputError("render", "unknown view '" + view + "'; use side, front, top or iso");
+  if (view != "side" && view != "front" && view != "top" && view != "iso" && view != "symmetry")
+    throw InputError("render",
+                     "unknown view '" + view + "'; use side, front, top, iso or symmetry");
 }
 
 /// "12.3 us" style time.
@@ -247,32 +232,20 @@ std::pair<double, double> colour_range(const RenderOptions& options,
   return {lo, hi};
 }
 
-/// Poly data of the kept particles: float positions and the field as scalars, the mirrored
-/// copies (at -x) after the particles; `bounds` is their bounding box.
-vtkSmartPointer<vtkPolyData> particle_poly(const Column& x, const std::vector<std::uint32_t>& keep,
-                                           const FieldValues& field, bool mirror,
+/// Poly data of the particles drawn: float positions and the field as scalars; `bounds` is
+/// their bounding box.
+vtkSmartPointer<vtkPolyData> particle_poly(const Drawn& drawn, const FieldValues& field,
                                            double bounds[6]) {
-  const std::size_t nk = keep.size();
-  const std::size_t np = mirror ? 2 * nk : nk;
+  const std::size_t np = drawn.size();
   vtkNew<vtkFloatArray> xyz;
   xyz->SetNumberOfComponents(3);
   xyz->SetNumberOfTuples(vtkIdType(np));
   vtkNew<vtkFloatArray> scalars;
   scalars->SetName(field.label.c_str());
   scalars->SetNumberOfTuples(vtkIdType(np));
-  float* pxyz = xyz->GetPointer(0);
-  float* ps = scalars->GetPointer(0);
-#pragma omp parallel for schedule(static)
-  for (std::size_t j = 0; j < nk; ++j) {
-    const auto p = position(x, keep[j]);
-    pxyz[3 * j] = float(p[0]), pxyz[3 * j + 1] = float(p[1]), pxyz[3 * j + 2] = float(p[2]);
-    ps[j] = field.values[keep[j]];
-    if (np > nk) {
-      float* q = pxyz + 3 * (nk + j);
-      q[0] = -float(p[0]), q[1] = float(p[1]), q[2] = float(p[2]);
-      ps[nk + j] = ps[j];
-    }
-  }
+  std::copy(drawn.xyz.begin(), drawn.xyz.end(), xyz->GetPointer(0));
+  std::copy(drawn.values.begin(), drawn.values.end(), scalars->GetPointer(0));
+  const float* pxyz = drawn.xyz.data();
   for (int a = 0; a < 3; ++a) {
     bounds[2 * a] = std::numeric_limits<double>::infinity();
     bounds[2 * a + 1] = -std::numeric_limits<double>::infinity();
@@ -358,12 +331,12 @@ vtkSmartPointer<vtkTextActor> title_text(const std::string& title, int h) {
   return text;
 }
 
-/// Camera: parallel projection fitted to the particles' bounding box seen from the view,
-/// with a margin of one particle radius and 6 %. Returns the parallel scale (m).
-double fit_camera(vtkRenderer* scene, const std::string& view, int dim, const double bounds[6],
-                  double radius, const double scene_vp[4], int w, int h) {
-  std::array<double, 3> dir{}, up{};
-  view_vectors(view, dim, dir, up);
+/// Camera: parallel projection fitted to the particles' bounding box seen along `view`, with a
+/// margin of one particle radius and 6 %: the whole body in frame. Returns the parallel scale
+/// (m).
+double fit_camera(vtkRenderer* scene, const ViewAxes& view, const double bounds[6], double radius,
+                  const double scene_vp[4], int w, int h) {
+  const auto& dir = view.dir;
   const double centre[3] = {0.5 * (bounds[0] + bounds[1]), 0.5 * (bounds[2] + bounds[3]),
                             0.5 * (bounds[4] + bounds[5])};
   double diag = 0;
@@ -375,13 +348,11 @@ double fit_camera(vtkRenderer* scene, const std::string& view, int dim, const do
   camera->SetFocalPoint(centre);
   camera->SetPosition(centre[0] - dir[0] * 2 * diag, centre[1] - dir[1] * 2 * diag,
                       centre[2] - dir[2] * 2 * diag);
-  camera->SetViewUp(up.data());
+  camera->SetViewUp(view.up.data());
   scene->ResetCamera(bounds);  // sets the distance and clipping range around the bounds
   camera->SetFocalPoint(centre);
   // Half extents of the bounding box along the screen's right and up directions.
-  const std::array<double, 3> right{dir[1] * up[2] - dir[2] * up[1],
-                                    dir[2] * up[0] - dir[0] * up[2],
-                                    dir[0] * up[1] - dir[1] * up[0]};
+  const std::array<double, 3>& right = view.right;
   double true_up[3];
   camera->GetViewUp(true_up);
   double hw = 0, hh = 0;
@@ -396,6 +367,27 @@ double fit_camera(vtkRenderer* scene, const std::string& view, int dim, const do
   const double scale = 1.06 * std::max({hh, hw / aspect, 1e-12});
   camera->SetParallelScale(scale);
   return scale;
+}
+
+/// The picture's caption: the view direction, the section and the mirror images drawn.
+std::string caption(const ViewAxes& view, const Section& section, const Drawn& drawn,
+                    const Symmetry& symmetry) {
+  std::string text = view.text;
+  char buf[96];
+  if (section.axis >= 0) {
+    std::snprintf(buf, sizeof buf, ", section %c = %.4g mm (the %s side)", "xyz"[section.axis],
+                  section.position * 1e3, drawn.keep_greater ? "+" : "-");
+    text += buf;
+  }
+  if (!symmetry.planes.empty()) {
+    text += symmetry.axisymmetric ? "; mirrored in " : "; whole body: mirror images in ";
+    for (std::size_t p = 0; p < symmetry.planes.size(); ++p) {
+      std::snprintf(buf, sizeof buf, "%s%c = %.4g mm", p ? ", " : "",
+                    "xyz"[symmetry.planes[p].axis], symmetry.planes[p].position * 1e3);
+      text += buf;
+    }
+  }
+  return text;
 }
 
 /// Renders the window once and writes its back buffer as a PNG through a FileTarget.
@@ -432,6 +424,9 @@ void render_png(const Frame& frame, int dim, const RenderOptions& options,
   check_picture_options(options);
   FieldValues field = evaluate_field(frame, options.field, options.component);
   const Clip clip = parse_clip(options.clip, dim);
+  const Section section = options.view == "symmetry" && dim == 3
+                              ? symmetry_section(options.symmetry)
+                              : parse_section(options.section, dim);
   const char* display = std::getenv("DISPLAY");
   if (!display || !*display)
     throw InputError(
@@ -444,11 +439,11 @@ void render_png(const Frame& frame, int dim, const RenderOptions& options,
                          "'; unset DISPLAY to render under xvfb-run, or start the X server");
 
   const std::vector<std::uint32_t> keep = kept_particles(x, n, clip, options.clip);
-  if (options.mirror && dim != 2)
-    throw InputError("render", "mirroring is for 2D (axisymmetric) frames");
+  const Drawn drawn = drawn_particles(x, keep, field, options.symmetry, section);
+  const ViewAxes view = view_axes(options.view, dim, section, drawn.keep_greater);
   const auto [lo, hi] = colour_range(options, field.values);
   double bounds[6];
-  auto poly = particle_poly(x, keep, field, options.mirror, bounds);
+  auto poly = particle_poly(drawn, field, bounds);
   const double radius = options.point_radius > 0
                             ? options.point_radius
                             : estimate_radius(frame, dim, options.axisymmetric, keep, bounds);
@@ -459,9 +454,10 @@ void render_png(const Frame& frame, int dim, const RenderOptions& options,
   actor->GetProperty()->SetAmbient(0.0);
   actor->GetProperty()->SetDiffuse(1.0);
 
-  // The particles fill a viewport left of the colour bar and below the title, drawn over a
-  // window-wide white renderer that holds the title and the colour bar.
-  const double scene_vp[4] = {0.0, 0.0, 0.84, 0.92};
+  // The particles fill a viewport left of the colour bar, below the title and above the scale
+  // bar, drawn over a window-wide white renderer that holds the title, the colour bar and the
+  // scale bar.
+  const double scene_vp[4] = {0.0, 0.09, 0.84, 0.92};
   vtkNew<vtkRenderer> overlay;
   overlay->SetLayer(0);
   overlay->SetBackground(1, 1, 1);
@@ -487,7 +483,8 @@ void render_png(const Frame& frame, int dim, const RenderOptions& options,
   window->AddRenderer(overlay);
   window->SetSize(w, h);
 
-  const double scale = fit_camera(scene, options.view, dim, bounds, radius, scene_vp, w, h);
+  const double scale = fit_camera(scene, view, bounds, radius, scene_vp, w, h);
+  add_scale_bar(overlay, scene_vp, w, h, scale, caption(view, section, drawn, options.symmetry));
   // Particles smaller than a pixel would fall between the pixel centres and vanish.
   const double pixel = 2 * scale / ((scene_vp[3] - scene_vp[1]) * h);
   mapper->SetScaleFactor(std::max(radius, 0.75 * pixel));

@@ -111,7 +111,9 @@ int post_render(const RenderArgs& a) {
   }
   const int dim = chosen->columns.at("x").info().components;
   o.axisymmetric = scene && scene->axisymmetric && dim == 2;
-  o.mirror = o.axisymmetric && !a.half;  // the whole section through the axis
+  if (scene) o.symmetry = measure_symmetry(a.symmetry, *scene);  // the whole body
+  if (o.axisymmetric && !a.half)  // the whole section through the axis
+    o.symmetry.planes.insert(o.symmetry.planes.begin(), MirrorPlane{0, 0.0});
   render_png(*chosen, dim, o, a.output);
   // The time in us for impact runs, in s for slow ones (forming, the dimensionless V7 scenes).
   const bool slow = chosen->time >= 1e-2;

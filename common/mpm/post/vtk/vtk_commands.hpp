@@ -27,6 +27,7 @@ struct RenderArgs {
   std::string size = "1200x900";     ///< WIDTHxHEIGHT in pixels
   std::string range;                 ///< colour range MIN:MAX (SI); empty: the field's
   bool half = false;                 ///< axisymmetric frames: the half plane r >= 0 only
+  std::string symmetry;              ///< mirror planes (option_symmetry); empty: the scene's
   RenderOptions picture;             ///< field, component, view, clip, title, radius as given
 };
 int post_render(const RenderArgs& args);

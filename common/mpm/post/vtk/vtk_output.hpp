@@ -4,6 +4,7 @@
 #include <utility>
 #include <vector>
 
+#include "mpm/post/symmetry.hpp"
 #include "mpm/stream/stream.hpp"
 
 namespace mpm {
@@ -38,7 +39,8 @@ struct RenderOptions {
   int component = -1;           ///< for vectors/tensors: -1 magnitude, else that component
   int width = 1200, height = 900;
   std::string view = "side";  ///< "side" (looking along -y), "front" (-x), "top" (-z), "iso"
-                              ///< (from +x+y+z); 2D frames are always seen from +z
+                              ///< (from +x+y+z), "symmetry" (square on to a mirror plane: the
+                              ///< section there); 2D frames are always seen from +z
   bool range_given = false;   ///< else the range is the field's min..max in the frame
   double range_min = 0, range_max = 0;
   std::string title;        ///< drawn at the top; empty: field name and time
@@ -47,12 +49,17 @@ struct RenderOptions {
                      ///< ("y>0.002" or "y>2mm": a plane that far from the centroid)
   bool axisymmetric = false;  ///< 2D frame of an axisymmetric scene: a particle's mass is per
                               ///< radian, its area m / (rho r) (for the automatic radius)
-  bool mirror = false;        ///< 2D: draw each particle also at (-x, y): an axisymmetric frame's
-                              ///< whole section through the axis
+  /// Mirror images drawn with each particle: the whole body of a quarter or half model; an
+  /// axisymmetric frame's whole section through the axis (the plane x = 0). None: as it is.
+  Symmetry symmetry;
+  /// "y = 0", "x = 2 mm": cut the body (with its images) at this plane, keep the side holding
+  /// more particles and look square at the cut. Empty: no section.
+  std::string section;
 };
 
 /// Renders a frame to a PNG off-screen, particles as spheres coloured by a field (viridis)
-/// with a colour bar, orthographic camera. Needs an X server (use ensure_display first).
+/// with a colour bar, orthographic camera fitted to what is drawn, a scale bar and the view
+/// direction. Needs an X server (use ensure_display first).
 /// Throws InputError for an unknown field (listing the available ones), bad options, or no
 /// X display that can be opened; IoError when the PNG cannot be written.
 void render_png(const Frame& frame, int dim, const RenderOptions& options, const std::string& path);

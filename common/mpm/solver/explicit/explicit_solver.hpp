@@ -31,8 +31,11 @@ class ExplicitSolver : public SolverCore<GridT> {
                  ScatterStrategy strategy = ScatterStrategy::Colored);
   ~ExplicitSolver();
 
-  /// One time step of size dt (at most stable_dt()). Throws InstabilityError.
-  void step(double dt);
+  /// One time step of size dt (at most stable_dt()). Throws InstabilityError. dt_pace (s) is
+  /// the step the run would have taken had it not shortened this one to land on a frame time
+  /// (0: dt); the leapfrog energy is evaluated at it, so that a shortened step does not make
+  /// it jump (balance().leapfrog_total).
+  void step(double dt, double dt_pace = 0);
 
   /// The largest stable step for the current state: cfl * h / max_p(c_p + |v_p|) (and dt_max).
   double stable_dt() const { return stable_dt_; }
@@ -42,6 +45,10 @@ class ExplicitSolver : public SolverCore<GridT> {
   /// Force (N) on the first body of each [[contact]] pair from the second in the last step
   /// (per metre in plane strain, per radian in axisymmetry), in the order of Scene::contacts.
   const std::vector<Vec3>& contact_force() const { return contact_.force(); }
+  /// The state between steps beyond the particle columns (SolverCore's, the stable step and
+  /// the split counters); restore on a solver built from the columns saved with it.
+  void save_state(StateValues& s) const;
+  void restore_state(const StateValues& s);
   /// Bytes held by the solver beyond the particle columns: grid window, private scatter
   /// arrays, sort scratch and bins.
   std::size_t work_bytes() const;
@@ -155,6 +162,7 @@ class ExplicitSolver : public SolverCore<GridT> {
   SplitScan scan_for_splits() requires GridT::kGraded;
   void write_children(const SplitScan& scan, std::size_t n) requires GridT::kGraded;
   void finish(std::vector<ChunkSums>& stats, int changed);
+  void leapfrog_balance(double dt, double dt_pace, double internal_start, double kinetic_start);
 
   using Core::axisymmetric_, Core::balance_, Core::binning_, Core::dt_, Core::exits_,
       Core::face_force_, Core::gravity_, Core::grid_, Core::has_rigid_, Core::material_,
@@ -170,6 +178,9 @@ class ExplicitSolver : public SolverCore<GridT> {
   double cfl_, dt_max_;
   double stable_dt_ = 0;
   double leapfrog_kinetic_ = 0;  ///< sum m v(k-1/2).v(k+1/2) / 2 of the last step
+  bool loads_ = false;           ///< a body force or loads act (their work is booked)
+  double load_work_ = 0;         ///< J: their work in the last step (ChunkSums::work)
+  double load_work_start_ = 0;   ///< J: its part at the velocities before the step
   std::uint32_t next_id_ = 0;    ///< id of the next particle a split creates (0: not yet known)
   long split_count_ = 0;         ///< particles split so far
   int split_wait_ = 0;           ///< steps the pending splits have waited for a sort

@@ -22,10 +22,10 @@
 namespace mpm {
 
 template <Grid GridT>
-void ExplicitSolver<GridT>::step(double dt) {
+void ExplicitSolver<GridT>::step(double dt, double dt_pace) {
   dt_ = dt;
   if (need_sort_) sort_particles();  // cell order; the grid window follows the material
-  const double internal_start = balance_.internal;
+  const double internal_start = balance_.internal, kinetic_start = balance_.kinetic;
   switch (scheme_) {
     case Scheme::USF:                           // update stress first (004, section 3.4)
       p2g<kMass | kMomentum>();                 // m_i, p_i (004, eqs. 24-25)
@@ -50,10 +50,7 @@ void ExplicitSolver<GridT>::step(double dt) {
       break;
   }
   if constexpr (GridT::kGraded) split_particles();  // coarse particles in finer cells (004, 3.3)
-  // USF computes its forces from the stress it just updated, MUSL and USL from last step's.
-  const double internal_paired = scheme_ == Scheme::USF ? balance_.internal : internal_start;
-  balance_.leapfrog_total =
-      leapfrog_kinetic_ + internal_paired + balance_.removed - balance_.external_work;
+  leapfrog_balance(dt, dt_pace, internal_start, kinetic_start);
   this->end_step(dt, "lower solver.cfl");  // the clock, the energy guard
 }
 
@@ -70,6 +67,7 @@ ExplicitSolver<GridT>::ExplicitSolver(const Scene& scene, GridT grid, ColumnStor
       cfl_(scene.solver.cfl),
       dt_max_(scene.solver.dt_max) {
   if (strategy == ScatterStrategy::LRSlabs) binning_.target_chunks = 2 * omp_get_max_threads();
+  loads_ = particles_.has(col::f_ext) || !gravity_.isZero();
   if (contact_.active() && strategy != ScatterStrategy::Colored &&
       strategy != ScatterStrategy::LRSlabs)
     throw InputError("--strategy",
@@ -81,6 +79,49 @@ ExplicitSolver<GridT>::ExplicitSolver(const Scene& scene, GridT grid, ColumnStor
 
 template <Grid GridT>
 ExplicitSolver<GridT>::~ExplicitSolver() = default;
+
+/// The energy central differences conserve after a step of dt, paired with the configuration
+/// the forces came from: sum m v_old.(v_old + a dt_pace) / 2 = K + r (L - K), r = dt_pace /
+/// dt, with K the kinetic energy at the start and L the leapfrog kinetic energy of the step.
+/// It is the leapfrog's modified energy for a step of dt_pace, which a step of dt keeps to
+/// O(dt^2): a step shortened to land on a frame time no longer moves it by (dt - dt_pace)
+/// sum m v.a / 2. The work of the loads is paired the same way: the work before the step
+/// and r times its part at the start velocities (the leapfrog total of a particle under a
+/// constant force F is then constant to round-off). Rigid bodies' work is booked whole.
+template <Grid GridT>
+void ExplicitSolver<GridT>::leapfrog_balance(double dt, double dt_pace, double internal_start,
+                                             double kinetic_start) {
+  // USF computes its forces from the stress it just updated, MUSL and USL from last step's.
+  const double internal_paired = scheme_ == Scheme::USF ? balance_.internal : internal_start;
+  double kinetic = leapfrog_kinetic_, work = balance_.external_work;
+  if (loads_) work += load_work_start_ - load_work_;
+  if (dt_pace > 0 && dt_pace != dt) {
+    const double r = dt_pace / dt;
+    kinetic = kinetic_start + r * (leapfrog_kinetic_ - kinetic_start);
+    if (loads_) work += (r - 1) * load_work_start_;
+  }
+  balance_.leapfrog_total = kinetic + internal_paired + balance_.removed - work;
+}
+
+template <Grid GridT>
+void ExplicitSolver<GridT>::save_state(StateValues& s) const {
+  Core::save_state(s);
+  s.set("stable_dt", stable_dt_);
+  s.set("leapfrog_kinetic", leapfrog_kinetic_);
+  s.set("next_id", double(next_id_));
+  s.set("splits", double(split_count_));
+  s.set("split_wait", double(split_wait_));
+}
+
+template <Grid GridT>
+void ExplicitSolver<GridT>::restore_state(const StateValues& s) {
+  Core::restore_state(s);
+  stable_dt_ = s.get("stable_dt");
+  leapfrog_kinetic_ = s.get("leapfrog_kinetic");
+  next_id_ = std::uint32_t(s.get("next_id"));
+  split_count_ = long(s.get("splits"));
+  split_wait_ = int(s.get("split_wait"));
+}
 
 template <Grid GridT>
 std::size_t ExplicitSolver<GridT>::work_bytes() const {
@@ -98,7 +139,12 @@ template <Grid GridT>
 void ExplicitSolver<GridT>::finish(std::vector<ChunkSums>& stats, int changed) {
   ChunkSums total;
   reduce(stats, total);
-  if (changed & kVelocities) leapfrog_kinetic_ = total.leapfrog_kinetic;
+  if (changed & kVelocities) {
+    leapfrog_kinetic_ = total.leapfrog_kinetic;
+    load_work_ = total.work;
+    load_work_start_ = total.work_start;
+    balance_.external_work += total.work;
+  }
   if (changed & kStresses) {
     balance_.internal = total.internal;
     stable_dt_ = std::min(dt_max_, cfl_ * total.dt_min);
@@ -106,7 +152,6 @@ void ExplicitSolver<GridT>::finish(std::vector<ChunkSums>& stats, int changed) {
   if (changed & kPositions) {
     balance_.kinetic = total.kinetic;
     balance_.momentum = total.momentum;
-    balance_.external_work += total.work;
     const double n = double(std::max<std::size_t>(1, particles_.size()));
     if (total.out_of_window || !exits_.empty() || total.strays > 0.01 * n ||
         total.off_bin > 0.1 * n)

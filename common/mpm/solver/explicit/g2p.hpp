@@ -148,9 +148,10 @@ void ExplicitSolver<GridT>::advance_particle(const ParticleView<D>& p, std::uint
   const Vec<D> v_old = p.v[i];
   p.v[i] += dt * a_p;  // (000, eq. 8)
   s.leapfrog_kinetic += 0.5 * p.m[i] * v_old.dot(p.v[i]);
+  if (loads_) s.add_load_work(p, i, dt, gravity_, v_old);
   if constexpr (kMove) {
     p.x[i] += dt * vbar;  // (000, eq. 7)
-    s.add_motion(p, i, dt, gravity_);
+    s.add_motion(p, i);
     track_move(p.x[i], i, bin_key, s);
   }
 }

@@ -101,7 +101,7 @@ template <bool C>
       ++pb.k;
       if (move) {
         p.x[i] += dt * vbar;  // (000, eq. 7)
-        s.add_motion(p, i, dt, gravity_);
+        s.add_motion(p, i);
         track_move(p.x[i], i, bin.key, s);
       }
     }

@@ -148,11 +148,13 @@ void ImplicitSolver<GridT>::commit(const nk::Vector& u) {
             if (!momentum && grid_.m[nd[c]] > floor)
               dv += N[c] * increment(nd[c], v_L[nd[c]] - v_k_[nd[c]]);
           }
+          const Vec<D> v_old = p.v[i];
           p.v[i] = momentum ? t.v_p[i] : Vec<D>(p.v[i] + dv);
           p.x[i] += dt * vbar;
           copy_state(trial, i, p, i);
           s.internal += p.m[i] * p.e[i];
-          s.add_motion(p, i, dt, gravity_);
+          s.add_motion(p, i);
+          s.add_load_work(p, i, dt, gravity_, v_old);
         }
         track_move(p.x[i], i, bins[bi].key, s);
       }

@@ -15,7 +15,8 @@ namespace {
 class LinearEos final : public Eos {
  public:
   explicit LinearEos(const MaterialSpec& m) : rho0_(m.density), K_(m.bulk_modulus()) {}
-  void coefficients(int n, const double* rho, double* A, double* B, double* K) const override {
+  void coefficients(int n, const double* rho, const double* /*e*/, double* A, double* B,
+                    double* K) const override {
     for (int i = 0; i < n; ++i) {
       A[i] = K_ * (rho[i] / rho0_ - 1.0);
       B[i] = 0.0;
@@ -43,7 +44,8 @@ class MieGruneisenEos final : public Eos {
     // beyond that are outside the fitted shock data anyway).
     mu_max_ = s_ > 1.0 ? 0.95 / (s_ - 1.0) : 1e9;
   }
-  void coefficients(int n, const double* rho, double* A, double* B, double* K) const override {
+  void coefficients(int n, const double* rho, const double* /*e*/, double* A, double* B,
+                    double* K) const override {
     const double k0 = rho0_ * c0_ * c0_;
     for (int i = 0; i < n; ++i) {
       const double mu = std::min(rho[i] / rho0_ - 1.0, mu_max_);

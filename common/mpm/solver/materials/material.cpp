@@ -24,6 +24,40 @@ double widened(double c, double Q) {
 }
 }  // namespace
 
+// The energy equation of one particle over a step: e_new = e + (s_old + s_new)/2 : de v_mid -
+// (P_old + P_new)/2 dv, with P = p + q, dv = dvol v_old the change of specific volume (exact:
+// V_new = V_old (1 + dvol)) and v_mid its mean. With p = A + B e_new it is solved for p at once.
+Material::EnergyStep Material::energy_step(const MaterialBlock& b, const BlockScratch& S,
+                                           int i) const {
+  const double rho = b.rho[i];
+  const double dvol = S.dvol[i];
+  const double trD = dvol / b.dt;
+  const double c_bulk = std::sqrt(std::max(S.K[i], 0.0) / rho);
+  EnergyStep es;
+  // Artificial bulk viscosity in compression, linear + quadratic.
+  es.q =
+      trD < 0 ? rho * b.h * (bulk_quadratic_ * b.h * trD * trD - bulk_linear_ * c_bulk * trD) : 0.0;
+  const double v_old = 1.0 / (rho * (1.0 + dvol));  // rho is already the new density
+  es.k = 0.5 * dvol * v_old;
+  es.v_mid = v_old * (1.0 + 0.5 * dvol);
+  return es;
+}
+
+// An EOS nonlinear in e: its tangent at the energy of t^n gives the first Newton iterate of
+// the energy equation, e_1 = e* - (p_1 + q) k (no failure yet: an estimate); the update then
+// solves it on the tangent at e_1, the second Newton iterate (its error is (dp/de)' (e_2 -
+// e_1)^2 k / 2, second order in the step's energy change).
+void Material::tangent_at_step_energy(const MaterialBlock& b, BlockScratch& S) const {
+  eos_->coefficients(b.n, b.rho, b.e, S.A, S.B, S.K);
+  for (int i = 0; i < b.n; ++i) {
+    const EnergyStep es = energy_step(b, S, i);
+    const double e_star = es.e_star(b.e[i], S.s_old[i], S.s[i], S.de[i], S.P_old[i]);
+    const double p = es.pressure(S.A[i], S.B[i], e_star);
+    S.e_lin[i] = e_star - (p + es.q) * es.k;
+  }
+  eos_->coefficients(b.n, b.rho, S.e_lin, S.A, S.B, S.K);
+}
+
 std::string to_string(StrengthModel m) {
   switch (m) {
     case StrengthModel::Elastic:
@@ -41,6 +75,8 @@ std::string to_string(EosModel m) {
       return "linear";
     case EosModel::MieGruneisen:
       return "mie-gruneisen";
+    case EosModel::Tillotson:
+      return "tillotson";
   }
   return "?";
 }
@@ -53,6 +89,7 @@ const ModelRegistry& model_registry() {
     r.strength["johnson-cook"] = make_johnson_cook_strength;
     r.eos["linear"] = make_linear_eos;
     r.eos["mie-gruneisen"] = make_mie_gruneisen_eos;
+    r.eos["tillotson"] = make_tillotson_eos;
     return r;
   }();
   return registry;
@@ -71,8 +108,8 @@ Material::Material(const MaterialSpec& spec, const SolverSpec& solver)
     throw std::logic_error("material '" + spec.name + "': model not registered");
   strength_ = s->second(spec);
   eos_ = e->second(spec);
-  double rho0 = spec.density, A, B;
-  eos_->coefficients(1, &rho0, &A, &B, &K0_eos_);
+  double rho0 = spec.density, e0 = 0, A, B;
+  eos_->coefficients(1, &rho0, &e0, &A, &B, &K0_eos_);
 }
 
 double Material::reference_wave_speed() const {
@@ -86,7 +123,7 @@ double Material::hugoniot_density(double u_p) const {
   // root on (rho0, 20 rho0] (the EOS caps compression; a root beyond is no estimate anyway).
   auto f = [&](double rho) {
     double A, B, K;
-    eos_->coefficients(1, &rho, &A, &B, &K);
+    eos_->coefficients(1, &rho, &e, &A, &B, &K);
     return A + B * e - rho0 * u_p * u_p * rho / (rho - rho0);
   };
   double lo = rho0 * (1 + 1e-12), hi = 20 * rho0;
@@ -104,7 +141,7 @@ double Material::shocked_signal_speed(double u_p) const {
   if (!(rho > 0)) return reference_wave_speed() + u_p;
   const double e = 0.5 * u_p * u_p;
   double A, B, K;
-  eos_->coefficients(1, &rho, &A, &B, &K);
+  eos_->coefficients(1, &rho, &e, &A, &B, &K);
   const double c = std::sqrt((isentropic_bulk(K, B, A + B * e, rho) + 4.0 / 3.0 * G_) / rho);
   return widened(c, bulk_linear_ * c + bulk_quadratic_ * u_p) + u_p;
 }
@@ -298,29 +335,22 @@ void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
   // Deviatoric stress: elastic predictor and radial return.
   strength_->update(b, S, G_);
   // Equation of state at the new density: p = A + B e.
-  eos_->coefficients(b.n, b.rho, S.A, S.B, S.K);
+  if (eos_->linear_in_energy())
+    eos_->coefficients(b.n, b.rho, b.e, S.A, S.B, S.K);
+  else
+    tangent_at_step_energy(b, S);
 
   const double eps_f = spec_.failure.plastic_strain;
   const double p_min = spec_.failure.pressure;
   const bool failure = spec_.failure.enabled() && b.failed;
   for (int i = 0; i < b.n; ++i) {
     const double rho = b.rho[i];
-    const double dvol = S.dvol[i];
-    const double trD = dvol / dt;
-    const double c_bulk = std::sqrt(std::max(S.K[i], 0.0) / rho);
-    // Artificial bulk viscosity in compression, linear + quadratic.
-    const double q =
-        trD < 0 ? rho * b.h * (bulk_quadratic_ * b.h * trD * trD - bulk_linear_ * c_bulk * trD)
-                : 0.0;
-    // Energy per unit mass: e_new = e + (s_old + s_new)/2 : de v_mid - (P_old + P_new)/2 dv,
-    // with P = p + q, dv = dvol v_old the change of specific volume (exact: V_new = V_old
-    // (1 + dvol)) and v_mid its mean. With p = A + B e_new this is solved for p at once.
-    const double v_old = 1.0 / (rho * (1.0 + dvol));  // rho is already the new density
-    const double k = 0.5 * dvol * v_old;
-    const double v_mid = v_old * (1.0 + 0.5 * dvol);
+    const double trD = S.dvol[i] / dt;
+    const EnergyStep es = energy_step(b, S, i);
+    const double q = es.q, k = es.k;
     auto pressure = [&](const Sym& s_new, double& e_star) {
-      e_star = b.e[i] + 0.5 * ddot(S.s_old[i] + s_new, S.de[i]) * v_mid - S.P_old[i] * k;
-      return (S.A[i] + S.B[i] * (e_star - q * k)) / (1.0 + S.B[i] * k);
+      e_star = es.e_star(b.e[i], S.s_old[i], s_new, S.de[i], S.P_old[i]);
+      return es.pressure(S.A[i], S.B[i], e_star);
     };
     double e_star;
     double p = pressure(S.s[i], e_star);

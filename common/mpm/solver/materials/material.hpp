@@ -86,17 +86,25 @@ struct BlockScratch {
   double P_old[kBlock];                    ///< old pressure incl. viscosity, Pa
   double A[kBlock], B[kBlock], K[kBlock];  ///< EOS: p = A + B e; bulk modulus K
   double q[kBlock];                        ///< bulk viscosity, Pa
-  double dlambda[kBlock];                  ///< plastic strain increment of this step
-  double yield[kBlock];                    ///< flow stress after the step, Pa
+  double e_lin[kBlock];    ///< EOS nonlinear in e: the energy its tangent is taken at, J/kg
+  double dlambda[kBlock];  ///< plastic strain increment of this step
+  double yield[kBlock];    ///< flow stress after the step, Pa
 };
 
 /// Equation of state, written as p = A(rho) + B(rho) e with e the specific internal energy,
-/// so the energy equation can be solved for the new pressure without iteration.
+/// so the energy equation can be solved for the new pressure without iteration. An EOS
+/// nonlinear in e gives the tangent at the energy it is handed (p = A + B e exactly there,
+/// B = dp/de), and the update solves the energy equation by Newton steps on it.
 class Eos {
  public:
   virtual ~Eos() = default;
-  /// For each particle i < n: A[i], B[i] and the bulk modulus K[i] (Pa) at density rho[i].
-  virtual void coefficients(int n, const double* rho, double* A, double* B, double* K) const = 0;
+  /// For each particle i < n: A[i], B[i] (Pa, Pa kg/J) and the bulk modulus K[i] (Pa; rho
+  /// dp/drho at constant e, or the EOS's floor under it) at density rho[i] (kg/m^3) and
+  /// specific internal energy e[i] (J/kg; ignored when linear_in_energy()).
+  virtual void coefficients(int n, const double* rho, const double* e, double* A, double* B,
+                            double* K) const = 0;
+  /// True when A, B and K do not depend on e (one solve of the energy equation is exact).
+  virtual bool linear_in_energy() const { return true; }
 };
 
 /// Deviatoric strength: updates s (the rotated old deviator on entry) by the deviatoric strain
@@ -146,6 +154,22 @@ class Material {
 
  private:
   void update_once(MaterialBlock& blk, BlockScratch& S) const;
+  /// One particle's energy equation over a step (material.cpp).
+  struct EnergyStep {
+    double q = 0;      ///< bulk viscosity, Pa
+    double k = 0;      ///< half the change of specific volume, m^3/kg
+    double v_mid = 0;  ///< mean specific volume over the step, m^3/kg
+    /// The energy before the new pressure's work, J/kg.
+    double e_star(double e, const Sym& s_old, const Sym& s_new, const Sym& de, double P_old) const {
+      return e + 0.5 * ddot(s_old + s_new, de) * v_mid - P_old * k;
+    }
+    /// The new pressure (Pa) from p = A + B e_new, e_new = e_star - (p + q) k.
+    double pressure(double A, double B, double e_star) const {
+      return (A + B * (e_star - q * k)) / (1.0 + B * k);
+    }
+  };
+  EnergyStep energy_step(const MaterialBlock& b, const BlockScratch& S, int i) const;
+  void tangent_at_step_energy(const MaterialBlock& b, BlockScratch& S) const;
   void update_plane_stress(MaterialBlock& blk, BlockScratch& S) const;
   struct PlaneStressIteration;
   void update_iterating(MaterialBlock& b, PlaneStressIteration& it, const int* idx, int k,
@@ -168,7 +192,7 @@ struct ModelRegistry {
   std::map<std::string, EosFactory> eos;
 };
 /// The registry with every built-in model: strength "elastic", "j2", "johnson-cook";
-/// eos "linear", "mie-gruneisen".
+/// eos "linear", "mie-gruneisen", "tillotson".
 const ModelRegistry& model_registry();
 /// Registry key of a scene enum.
 std::string to_string(StrengthModel m);

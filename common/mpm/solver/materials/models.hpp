@@ -7,6 +7,8 @@
 namespace mpm {
 std::unique_ptr<Eos> make_linear_eos(const MaterialSpec& m);
 std::unique_ptr<Eos> make_mie_gruneisen_eos(const MaterialSpec& m);
+/// Tillotson (docs/eos-tillotson.md): compressed, cold and hot expanded branches.
+std::unique_ptr<Eos> make_tillotson_eos(const MaterialSpec& m);
 std::unique_ptr<Strength> make_elastic_strength(const MaterialSpec& m);
 /// Isotropic hardening sigma_y = A + B eps_p^n (no rate or thermal term).
 std::unique_ptr<Strength> make_j2_strength(const MaterialSpec& m);
