@@ -74,10 +74,20 @@ class ContactFields {
   /// Force (N) on the first body of each [[contact]] pair from the second in the last step.
   const std::vector<Vec3>& force() const { return force_; }
   std::vector<Vec3>& force() { return force_; }
+  /// Per node, the pairs of fields in contact after the last grid update (bit s: the s-th
+  /// pair of the fields present at the node, in field order); MUSL's remap follows them.
+  std::vector<std::uint64_t>& held() { return held_; }
+  /// Gap below which two fields touch at a node, in cells (distance of their centres there):
+  /// for two particles a cell per axis, bodies touching anywhere in a cell put those centres
+  /// 0.70 to 0.98 cells apart (linear shape functions); 1.5 leaves room for deformed
+  /// particles, so that bodies that touch are always in contact, and bodies more than half a
+  /// cell apart are not.
+  static constexpr double touch() { return 1.5; }
 
   /// Sizes every field to `nodes` nodes and zeroes mass, momentum, force and mass gradient
   /// (and the remapped momentum when `remap`).
   void clear(std::size_t nodes, bool remap) {
+    held_.resize(nodes);
     for (Field& f : fields_) {
       const std::int64_t n = std::int64_t(nodes);
       f.m.resize(nodes), f.v.resize(nodes), f.a.resize(nodes), f.g.resize(nodes);
@@ -98,6 +108,7 @@ class ContactFields {
       b += f.m.capacity() * sizeof(double) +
            (f.v.capacity() + f.a.capacity() + f.g.capacity() + f.q.capacity() + f.x.capacity()) *
                sizeof(Vec<D>);
+    b += held_.capacity() * sizeof(std::uint64_t);
     return b;
   }
 
@@ -108,6 +119,7 @@ class ContactFields {
   std::vector<int> pair_;
   std::vector<double> sign_;
   std::vector<Vec3> force_;
+  std::vector<std::uint64_t> held_;
 };
 
 }  // namespace mpm
