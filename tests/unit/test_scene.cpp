@@ -400,7 +400,8 @@ TEST(SceneErrors, FilesNameFileLineAndKey) {
        "materials.copper.densty: unknown key (expected one of: density, youngs_modulus, "
        "poisson_ratio, strength, eos, failure)"},
       {"bad_unknown_top.toml", 19,
-       "outptu: unknown key (expected one of: scene, materials, bodies, loads, grid, boundary, "
+       "outptu: unknown key (expected one of: scene, materials, bodies, loads, contact, grid, "
+       "boundary, "
        "solver, "
        "output)"},
       {"bad_unknown_nested.toml", 9, "materials.copper.strength.hardening: unknown key"},

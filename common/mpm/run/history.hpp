@@ -55,6 +55,10 @@ class History {
         rigid_.push_back(int(b));
         for (int a = 0; a < dim; ++a) add("force_" + scene.bodies[b].name + "_" + "xyz"[a], "N");
       }
+    for (const auto& c : scene.contacts) {  // force on the first body of each pair
+      const std::string pair = scene.bodies[c.body_a].name + "_" + scene.bodies[c.body_b].name;
+      for (int a = 0; a < dim; ++a) add("contact_" + pair + "_" + "xyz"[a], "N");
+    }
     add_body_columns(scene);
     if (implicit_) {
       // Work of the implicit solver since the previous row, then totals since t = 0.
@@ -88,6 +92,9 @@ class History {
     for (int f : faces_) row.push_back(factor_ * s.face_force()[f]);
     for (int b : rigid_)
       for (int a = 0; a < dim_; ++a) row.push_back(factor_ * s.rigid_force()[b][a]);
+    if constexpr (requires { s.contact_force(); })
+      for (const Vec3& f : s.contact_force())
+        for (int a = 0; a < dim_; ++a) row.push_back(factor_ * f[a]);
     if (!bodies_.empty()) body_values(const_cast<Solver&>(s).particles(), row);
     if constexpr (HasImplicitWork<Solver>) {
       const ImplicitWork& w = s.work();

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "mpm/core/error.hpp"
@@ -395,6 +397,73 @@ void read_loads(Reader& top, Scene& s) {
     }
     r.finish();
     s.loads.push_back(l);
+  }
+}
+
+}  // namespace mpm::scene_toml
+
+namespace mpm::scene_toml {
+
+namespace {
+
+/// The two body names of a [[contact]] table, as body indices (unknown, rigid or repeated
+/// bodies are errors).
+std::pair<int, int> read_contact_bodies(Reader& r, const Scene& s) {
+  const toml::node* node = r.get("bodies");
+  const std::string expected = "two body names, e.g. [\"projectile\", \"plate\"]";
+  if (!node) r.missing("bodies", expected);
+  const auto* arr = node->as_array();
+  if (!arr || arr->size() != 2 || !(*arr)[0].is_string() || !(*arr)[1].is_string())
+    r.fail("bodies", "expected " + expected + ", " + got(*node));
+  int index[2];
+  for (int k = 0; k < 2; ++k) {
+    const std::string name = (*arr)[std::size_t(k)].as_string()->get();
+    index[k] = s.body_index(name);
+    if (index[k] < 0) {
+      std::vector<std::string_view> known;
+      for (const auto& b : s.bodies) known.push_back(b.name);
+      r.fail("bodies", "unknown body '" + name + "' (known: " + join(known) + ")");
+    }
+    if (s.bodies[index[k]].rigid)
+      r.fail("bodies", "body '" + name +
+                           "' is rigid: rigid bodies hold the nodes they touch (their contact is "
+                           "set by the body's `slip` key), they take no part in [[contact]]");
+  }
+  if (index[0] == index[1])
+    r.fail("bodies", "a body cannot be in contact with itself ('" + s.bodies[index[0]].name +
+                         "' is named twice)");
+  return {index[0], index[1]};
+}
+
+}  // namespace
+
+void read_contacts(Reader& top, Scene& s) {
+  const toml::node* node = top.get("contact");
+  if (!node) return;
+  const auto* arr = node->as_array();
+  if (!arr)
+    top.fail("contact",
+             "expected an array of tables ([[contact]], note the double brackets), " + got(*node));
+  const Doc& doc = top.doc();
+  const Origin array_origin = top.origin_of(*node);
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    const toml::node& e = (*arr)[i];
+    const std::string path = "contact." + std::to_string(i);
+    const Origin o = doc.origin(e, array_origin);
+    const auto* t = e.as_table();
+    if (!t) throw InputError(doc.where(o, path), "expected a table ([[contact]]), " + got(e));
+    Reader r(doc, *t, path, o, {"bodies", "friction"});
+    ContactSpec c;
+    c.loc = r.loc();
+    std::tie(c.body_a, c.body_b) = read_contact_bodies(r, s);
+    c.friction = r.number("friction", Bound::NonNegative).value_or(0.0);
+    for (const auto& other : s.contacts)
+      if (std::minmax(other.body_a, other.body_b) == std::minmax(c.body_a, c.body_b))
+        r.fail("bodies", "the pair '" + s.bodies[c.body_a].name + "', '" + s.bodies[c.body_b].name +
+                             "' is already in contact (" +
+                             where(other.loc.file, other.loc.line, other.loc.key) + ")");
+    r.finish();
+    s.contacts.push_back(c);
   }
 }
 

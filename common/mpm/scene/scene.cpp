@@ -63,12 +63,14 @@ void check_axisymmetric(const Scene& s) {
 }
 
 void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
-  Reader top(doc, root, "", Origin{},
-             {"scene", "materials", "bodies", "loads", "grid", "boundary", "solver", "output"});
+  Reader top(
+      doc, root, "", Origin{},
+      {"scene", "materials", "bodies", "loads", "contact", "grid", "boundary", "solver", "output"});
   read_scene_table(top, s);
   read_materials(top, s);
   read_bodies(top, s);
   read_loads(top, s);
+  read_contacts(top, s);
 
   {
     Reader g = top.required_table("grid", {"cell_size", "domain", "padding", "sparse", "levels"},
@@ -93,6 +95,12 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
     read_output(*o, s);
   }
   if (s.axisymmetric) check_axisymmetric(s);
+  if (!s.contacts.empty() && s.solver.type == SolverType::Implicit) {
+    const SourceLoc& c = s.contacts.front().loc;
+    throw InputError(where(c.file, c.line, c.key),
+                     "contact between bodies needs the explicit solver (solver.type = "
+                     "\"explicit\"); the implicit solver has one velocity field");
+  }
   top.finish();
 }
 

@@ -156,6 +156,16 @@ struct LoadSpec {
   SourceLoc loc;
 };
 
+/// Contact between two deformable bodies (004, section 5.4; Bardenhagen et al. 2001): each
+/// body of a pair gets its own velocity field at the nodes it shares with the other; where the
+/// fields approach, their normal velocities are made equal and the tangential part obeys
+/// Coulomb friction; where they separate they stay free. Bodies in no pair share one field.
+struct ContactSpec {
+  int body_a = -1, body_b = -1;  ///< indices into Scene::bodies, as the pair names them
+  double friction = 0;           ///< Coulomb coefficient, >= 0; 0 = frictionless
+  SourceLoc loc;                 ///< key "contact.<index>"
+};
+
 /// A refined box of a graded grid (004, section 3.1): its cells are cell_size / 2^(level - 1)
 /// across. Boxes are aligned to the lattice of the next coarser level and nested.
 struct LevelSpec {
@@ -280,6 +290,7 @@ struct Scene {
   std::vector<MaterialSpec> materials;
   std::vector<BodySpec> bodies;
   std::vector<LoadSpec> loads;
+  std::vector<ContactSpec> contacts;  ///< body pairs in contact; empty: one velocity field
   GridSpec grid;
   BoundarySpec boundary;
   SolverSpec solver;

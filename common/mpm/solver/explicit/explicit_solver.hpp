@@ -12,6 +12,7 @@
 #include "mpm/grid/grid.hpp"
 #include "mpm/scene/scene.hpp"
 #include "mpm/solver/core.hpp"
+#include "mpm/solver/explicit/contact_fields.hpp"
 #include "mpm/solver/explicit/scatter.hpp"
 
 namespace mpm {
@@ -41,6 +42,9 @@ class ExplicitSolver : public SolverCore<GridT> {
   /// Particles split into 2^D children so far (graded grids, 004 section 3.3).
   long splits() const { return split_count_; }
   ScatterStrategy strategy() const { return scatter_.strategy(); }
+  /// Force (N) on the first body of each [[contact]] pair from the second in the last step
+  /// (per metre in plane strain, per radian in axisymmetry), in the order of Scene::contacts.
+  const std::vector<Vec3>& contact_force() const { return contact_.force(); }
   /// The state between steps beyond the particle columns (SolverCore's, the stable step and
   /// the split counters); restore on a solver built from the columns saved with it.
   void save_state(StateValues& s) const;
@@ -59,12 +63,19 @@ class ExplicitSolver : public SolverCore<GridT> {
   enum class G2pMode { Velocity, Move, Remap };
   /// Whether the stress update also advances the positions.
   enum class Positions { Stay, Move };
+  /// Which nodal velocities a contact exchange corrects: grid velocities (USF, before the
+  /// stress), updated velocities with their accelerations and the contact forces, or the
+  /// remapped velocities (MUSL).
+  enum class Exchange { Velocity, Update, Remap };
   /// What a particle kernel changed, for finish (bits).
   enum Changed { kVelocities = 1, kStresses = 2, kPositions = 4 };
 
   // Kernels, in the order a step uses them, each in the file named after it: p2g.hpp,
   // grid_update.hpp (grid_velocity, grid_update, grid_remap), g2p.hpp, stress.hpp and
-  // graded_split.hpp (split_particles).
+  // graded_split.hpp (split_particles); with [[contact]], the grid kernels end with the
+  // momentum exchange between the bodies' fields (contact.hpp). The particle kernels come in
+  // two builds, C: the scene has contact (each particle of a body in contact uses its body's
+  // field), or not (no contact code in the loop).
   template <int F>
   void p2g();
   void grid_velocity();
@@ -73,7 +84,24 @@ class ExplicitSolver : public SolverCore<GridT> {
   template <G2pMode M>
   void g2p();
   void update_stress(const std::vector<Vec<D>>& v_grad, Positions positions);
+  void exchange_momentum(Exchange on);
   void split_particles() requires GridT::kGraded;
+
+  // The particle kernels' builds with and without contact.
+  template <int F, bool C>
+  void scatter_to_grid();
+  template <G2pMode M, bool C>
+  void gather_from_grid();
+  /// Particle i (of a body in contact, field f) adds mass, momentum, mass gradient (F has
+  /// kMass) and force (F has kForce) to its field at the nodes nd of its cell `key`.
+  template <int F>
+  void add_to_field(const ParticleView<D>& p, std::uint32_t i, int f, std::int64_t key,
+                    const Vec<D>& xi, const std::int64_t* nd, int nk);
+
+  template <G2pMode M>
+  void advance_in_field(const ParticleView<D>& p, std::uint32_t i, int f, std::int64_t key,
+                        const Vec<D>& xi, const std::int64_t* nd, int nk, bool advance, bool remap,
+                        ChunkSums& s, std::int64_t bin_key);
 
   // Helpers.
   void mark_rigid_nodes();
@@ -113,16 +141,23 @@ class ExplicitSolver : public SolverCore<GridT> {
     at.nd = at.home ? nodes : other;
     return at;
   }
-  void momentum_to_velocity(std::vector<Vec<D>>& field);
-  void apply_boundary(std::vector<Vec<D>>& vel, std::vector<Vec<D>>* acc);
+  /// v = p / m at the nodes with mass, zero elsewhere, for one field's arrays.
+  void momentum_to_velocity(const double* m, Vec<D>* field);
+  /// One field's grid update: v_i = (p_i or v_i) + dt f_i / m_i, a_i = f_i / m_i.
+  void integrate_nodes(const double* m, Vec<D>* v, Vec<D>* a, NodeV in_v);
+  /// The boundary conditions and rigid bodies on every field's velocities (on: which ones).
+  void apply_boundary(Exchange on);
+  /// Holds one field's velocities (and accelerations, recording the forces, when acc).
+  void hold_nodes(const double* m, Vec<D>* vel, Vec<D>* acc);
   template <G2pMode M>
   void advance_particle(const ParticleView<D>& p, std::uint32_t i, std::int64_t key,
                         const Vec<D>& xi, const std::int64_t* nd, int nk, const Vec<D>* a_c,
                         const Vec<D>* v_c, double* N, ChunkSums& s, std::int64_t bin_key) const;
   void stress_block(const ParticleView<D>& p, PendingBlock& pb, StressScratch& scr,
                     ChunkSums& s) const;
+  template <bool C>
   void stress_chunk(const ParticleView<D>& p, int ch, const Vec<D>* vg_i, Positions positions,
-                    ChunkSums& s);
+                    bool remapped, ChunkSums& s);
   struct SplitScan;
   SplitScan scan_for_splits() requires GridT::kGraded;
   void write_children(const SplitScan& scan, std::size_t n) requires GridT::kGraded;
@@ -140,6 +175,7 @@ class ExplicitSolver : public SolverCore<GridT> {
 
   Scheme scheme_;
   Scatter<GridT> scatter_;
+  ContactFields<D> contact_;  ///< the bodies' own fields ([[contact]]); inactive without
   double cfl_, dt_max_;
   double stable_dt_ = 0;
   double leapfrog_kinetic_ = 0;  ///< sum m v(k-1/2).v(k+1/2) / 2 of the last step

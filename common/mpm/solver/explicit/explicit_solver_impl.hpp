@@ -2,13 +2,16 @@
 // Explicit MPM. The time step is ExplicitSolver::step, right below: a few named kernels whose
 // order is the only difference between USF, USL and MUSL. Each kernel is in the file named
 // after it (p2g.hpp, grid_update.hpp, g2p.hpp, stress.hpp, graded_split.hpp; the scatters in
-// scatter.hpp); construction and the reduction of the kernels' sums follow the step. Included
+// scatter.hpp); with [[contact]] the grid kernels end by exchanging momentum between the
+// bodies' velocity fields (contact.hpp). Construction and the reduction of the kernels' sums
+// follow the step. Included
 // by the translation units that instantiate the solver for a grid type.
 #include <omp.h>
 
 #include <algorithm>
 #include <cmath>
 
+#include "mpm/solver/explicit/contact.hpp"
 #include "mpm/solver/explicit/explicit_solver.hpp"
 #include "mpm/solver/explicit/g2p.hpp"
 #include "mpm/solver/explicit/graded_split.hpp"
@@ -60,10 +63,16 @@ ExplicitSolver<GridT>::ExplicitSolver(const Scene& scene, GridT grid, ColumnStor
     : Core(scene, std::move(grid), particles),
       scheme_(scene.solver.scheme),
       scatter_(strategy),
+      contact_(scene),
       cfl_(scene.solver.cfl),
       dt_max_(scene.solver.dt_max) {
   if (strategy == ScatterStrategy::LRSlabs) binning_.target_chunks = 2 * omp_get_max_threads();
   loads_ = particles_.has(col::f_ext) || !gravity_.isZero();
+  if (contact_.active() && strategy != ScatterStrategy::Colored &&
+      strategy != ScatterStrategy::LRSlabs)
+    throw InputError("--strategy",
+                     "a scene with [[contact]] needs the colored (default) or "
+                     "lr-slabs strategy: the bodies' fields have no private copies");
   sort_particles();
   stable_dt_ = this->start_energies();  // initial energies and the first stable time step
 }
@@ -117,7 +126,7 @@ void ExplicitSolver<GridT>::restore_state(const StateValues& s) {
 template <Grid GridT>
 std::size_t ExplicitSolver<GridT>::work_bytes() const {
   std::size_t b = grid_.nodes() * (sizeof(double) + 3 * sizeof(Vec<D>) + (has_rigid_ ? 1 : 0));
-  b += scatter_.bytes();
+  b += scatter_.bytes() + contact_.bytes();
   b += binning_.bins().capacity() * sizeof(Bin) + binning_.chunks().capacity() * sizeof(Chunk);
   return b;
 }

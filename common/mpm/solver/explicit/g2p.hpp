@@ -15,6 +15,18 @@ template <typename ExplicitSolver<GridT>::G2pMode M>
 void ExplicitSolver<GridT>::g2p() {
   constexpr bool kRemapped = M == G2pMode::Remap, kMove = M == G2pMode::Move;
   ScopedTimer timer(timers_, timers_.id(kRemapped ? "g2p_remap" : kMove ? "g2p_move" : "g2p"));
+  if (contact_.active())
+    gather_from_grid<M, true>();
+  else
+    gather_from_grid<M, false>();
+}
+
+/// The particle update of g2p; with contact (C), the particles of the bodies in contact read
+/// their bodies' fields (and remap into them).
+template <Grid GridT>
+template <typename ExplicitSolver<GridT>::G2pMode M, bool C>
+void ExplicitSolver<GridT>::gather_from_grid() {
+  constexpr bool kRemapped = M == G2pMode::Remap, kMove = M == G2pMode::Move;
   const ParticleView<D> p = view<D>(particles_);
   material_ = p.material;
   const Vec<D>* a_i = grid_.a.data();
@@ -44,6 +56,10 @@ void ExplicitSolver<GridT>::g2p() {
     if (rigid(i)) return;
     const int nk = grid_.cell_nodes(key, nd);
     double N[NMAX];
+    if constexpr (C)
+      if (const int f = contact_.field_of(p.body[i]))
+        return advance_in_field<M>(p, i, f, key, xi, nd, nk, first_visit, kRemapped, stats[unit],
+                                   key);
     if (first_visit)
       advance_particle<M>(p, i, key, xi, nd, nk, nullptr, nullptr, N, stats[unit], key);
     else
@@ -74,6 +90,13 @@ void ExplicitSolver<GridT>::g2p() {
       }
       const auto [key, xi, home, nk, nd] = locate_in_bin(bin.key, nodes, nn, p.x[i], other);
       double N[NMAX];
+      if constexpr (C)
+        if (const int f = contact_.field_of(p.body[i])) {
+          const bool remap = kRemapped && (home || !strays || grid_.layer(key) == layer);
+          advance_in_field<M>(p, i, f, key, xi, nd, nk, true, remap, s, bin.key);
+          if (kRemapped && !remap) strays->push_back(i);
+          continue;
+        }
       advance_particle<M>(p, i, key, xi, nd, nk, home ? a_c : nullptr, home ? v_c : nullptr, N, s,
                           bin.key);
       if constexpr (kRemapped) {
@@ -130,6 +153,29 @@ void ExplicitSolver<GridT>::advance_particle(const ParticleView<D>& p, std::uint
     p.x[i] += dt * vbar;  // (000, eq. 7)
     s.add_motion(p, i);
     track_move(p.x[i], i, bin_key, s);
+  }
+}
+
+/// Particle i of a body in contact (field f, cell `key`, nodes nd): its update from its
+/// field's nodal values when `advance`, its remapped momentum into the field when `remap`.
+template <Grid GridT>
+template <typename ExplicitSolver<GridT>::G2pMode M>
+void ExplicitSolver<GridT>::advance_in_field(const ParticleView<D>& p, std::uint32_t i, int f,
+                                             std::int64_t key, const Vec<D>& xi,
+                                             const std::int64_t* nd, int nk, bool advance,
+                                             bool remap, ChunkSums& s, std::int64_t bin_key) {
+  auto& fd = contact_.field(f);
+  double N[NMAX];
+  if (advance) {
+    Vec<D> a_f[NMAX], v_f[NMAX];
+    for (int c = 0; c < nk; ++c) a_f[c] = fd.a[nd[c]], v_f[c] = fd.v[nd[c]];
+    advance_particle<M>(p, i, key, xi, nd, nk, a_f, v_f, N, s, bin_key);
+  } else {
+    grid_.values(key, xi, N);
+  }
+  if (remap) {
+    const Vec<D> mv = p.m[i] * p.v[i];
+    for (int c = 0; c < nk; ++c) fd.q[nd[c]] += N[c] * mv;
   }
 }
 

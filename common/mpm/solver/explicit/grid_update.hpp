@@ -10,91 +10,124 @@ namespace mpm {
 template <Grid GridT>
 void ExplicitSolver<GridT>::grid_velocity() {
   ScopedTimer timer(timers_, timers_.id("grid_velocity"));
-  momentum_to_velocity(grid_.v);
+  momentum_to_velocity(grid_.m.data(), grid_.v.data());
+  for (int f = 1; f < contact_.field_count(); ++f)
+    momentum_to_velocity(contact_.field(f).m.data(), contact_.field(f).v.data());
+  exchange_momentum(Exchange::Velocity);
+  apply_boundary(Exchange::Velocity);
 }
 
 template <Grid GridT>
 void ExplicitSolver<GridT>::grid_update(NodeV in_v) {
   ScopedTimer timer(timers_, timers_.id("grid_update"));
+  integrate_nodes(grid_.m.data(), grid_.v.data(), grid_.a.data(), in_v);
+  for (int f = 1; f < contact_.field_count(); ++f) {
+    auto& fd = contact_.field(f);
+    integrate_nodes(fd.m.data(), fd.v.data(), fd.a.data(), in_v);
+  }
+  exchange_momentum(Exchange::Update);
+  apply_boundary(Exchange::Update);
+}
+
+template <Grid GridT>
+void ExplicitSolver<GridT>::integrate_nodes(const double* m_i, Vec<D>* v, Vec<D>* a, NodeV in_v) {
   const std::int64_t n = std::int64_t(grid_.nodes());
   const double floor = node_mass_floor_, dt = dt_;
   const bool momentum_in_v = in_v == NodeV::Momentum;
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
-    const double m = grid_.m[i];
+    const double m = m_i[i];
     if (m > floor) {
-      const Vec<D> a_i = grid_.a[i] / m;
-      const Vec<D> v_i = momentum_in_v ? Vec<D>(grid_.v[i] / m) : grid_.v[i];
-      grid_.v[i] = v_i + dt * a_i;  // p_i^{k+1} = p_i^k + f_i dt, divided by m_i
-      grid_.a[i] = a_i;
-    } else if (!grid_.v[i].isZero() || !grid_.a[i].isZero()) {  // keep empty nodes at zero
-      grid_.v[i].setZero();
-      grid_.a[i].setZero();
+      const Vec<D> a_i = a[i] / m;
+      const Vec<D> v_i = momentum_in_v ? Vec<D>(v[i] / m) : v[i];
+      v[i] = v_i + dt * a_i;  // p_i^{k+1} = p_i^k + f_i dt, divided by m_i
+      a[i] = a_i;
+    } else if (!v[i].isZero() || !a[i].isZero()) {  // keep empty nodes at zero
+      v[i].setZero();
+      a[i].setZero();
     }
   }
-  apply_boundary(grid_.v, &grid_.a);
 }
 
 template <Grid GridT>
 void ExplicitSolver<GridT>::grid_remap() {
   ScopedTimer timer(timers_, timers_.id("grid_remap"));
-  momentum_to_velocity(grid_.v_remap);
+  momentum_to_velocity(grid_.m.data(), grid_.v_remap.data());
+  for (int f = 1; f < contact_.field_count(); ++f)
+    momentum_to_velocity(contact_.field(f).m.data(), contact_.field(f).q.data());
+  exchange_momentum(Exchange::Remap);
+  apply_boundary(Exchange::Remap);
 }
 
 template <Grid GridT>
-void ExplicitSolver<GridT>::momentum_to_velocity(std::vector<Vec<D>>& field) {
+void ExplicitSolver<GridT>::momentum_to_velocity(const double* m, Vec<D>* field) {
   const std::int64_t n = std::int64_t(grid_.nodes());
   const double floor = node_mass_floor_;
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
-    if (grid_.m[i] > floor)
-      field[i] /= grid_.m[i];
+    if (m[i] > floor)
+      field[i] /= m[i];
     else if (!field[i].isZero())
       field[i].setZero();  // keep empty nodes at zero
   }
-  apply_boundary(field, nullptr);
 }
 
-/// Holds the velocities (and with `acc`, grid_update's accelerations, also recording the
-/// forces on the supports) where boundary conditions and rigid bodies prescribe them.
+/// Every field's velocities held where boundary conditions and rigid bodies prescribe them;
+/// after grid_update also its accelerations, recording the forces on the supports.
 template <Grid GridT>
-void ExplicitSolver<GridT>::apply_boundary(std::vector<Vec<D>>& vel, std::vector<Vec<D>>* acc) {
+void ExplicitSolver<GridT>::apply_boundary(Exchange on) {
+  const bool update = on == Exchange::Update;
+  if (update) {
+    face_force_.fill(0.0);
+    if (has_rigid_)
+      for (auto& f : rigid_force_) f.setZero();
+  }
+  auto& v0 = on == Exchange::Remap ? grid_.v_remap : grid_.v;
+  hold_nodes(grid_.m.data(), v0.data(), update ? grid_.a.data() : nullptr);
+  for (int f = 1; f < contact_.field_count(); ++f) {
+    auto& fd = contact_.field(f);
+    hold_nodes(fd.m.data(), (on == Exchange::Remap ? fd.q : fd.v).data(),
+               update ? fd.a.data() : nullptr);
+  }
+}
+
+/// Holds one field's velocities (and with `acc`, grid_update's accelerations, also recording
+/// the forces on the supports) where boundary conditions and rigid bodies prescribe them.
+template <Grid GridT>
+void ExplicitSolver<GridT>::hold_nodes(const double* m, Vec<D>* vel, Vec<D>* acc) {
   const bool record_force = acc != nullptr;  // grid_update: the forces on the supports
   // Record the force each face carries (before holding the velocities), then hold them.
   if (record_force) {
-    face_force_.fill(0.0);
     auto record = [&](std::int64_t n, int face) {
       const int axis = face / 2;
       const double sign = (face % 2 == 0) ? -1.0 : 1.0;
-      face_force_[face] += sign * grid_.m[n] * vel[n][axis] / dt_;
+      face_force_[face] += sign * m[n] * vel[n][axis] / dt_;
     };
     for (const auto& f : grid_.fixed_nodes()) record(f.node, f.face);
     for (const auto& f : grid_.slip_nodes()) record(f.node, f.face);
   }
   for (const auto& f : grid_.fixed_nodes()) {
     vel[f.node].setZero();
-    if (acc) (*acc)[f.node].setZero();
+    if (acc) acc[f.node].setZero();
   }
   for (const auto& f : grid_.slip_nodes()) {
     vel[f.node][f.face / 2] = 0.0;
-    if (acc) (*acc)[f.node][f.face / 2] = 0.0;
+    if (acc) acc[f.node][f.face / 2] = 0.0;
   }
   if (!has_rigid_) return;
   // Rigid bodies, serially (a few nodes; the force sums stay in node order).
-  if (record_force)
-    for (auto& f : rigid_force_) f.setZero();
   const std::int64_t n = std::int64_t(grid_.nodes());
   for (std::int64_t i = 0; i < n; ++i) {
     const int mark = grid_.rigid[i];
-    if (mark == 0 || grid_.m[i] <= node_mass_floor_) continue;
+    if (mark == 0 || m[i] <= node_mass_floor_) continue;
     const std::uint32_t body = marked_body_[mark - 1];
     const Vec<D>& vb = rigid_velocity_[body];
     const std::uint8_t held = rigid_held_[body];  // the other components slip
     for (int a = 0; a < D; ++a) {
       if (!(held >> a & 1)) continue;
       if (record_force)  // what the body pushes back; its work on the material
-        book_rigid_force(int(body), a, grid_.m[i] * (vel[i][a] - vb[a]) / dt_);
-      if (acc) (*acc)[i][a] += (vb[a] - vel[i][a]) / dt_;
+        book_rigid_force(int(body), a, m[i] * (vel[i][a] - vb[a]) / dt_);
+      if (acc) acc[i][a] += (vb[a] - vel[i][a]) / dt_;
       vel[i][a] = vb[a];
     }
   }

@@ -11,11 +11,23 @@ void ExplicitSolver<GridT>::p2g() {
   ScopedTimer timer(timers_, timers_.id(F == kForce    ? "p2g_force"
                                         : (F & kForce) ? "p2g"
                                                        : "p2g_mass_momentum"));
-  constexpr bool kM = F & kMass, kP = F & kMomentum, kF = F & kForce;
-  if constexpr (kM) {
+  if constexpr (F & kMass) {
     grid_.clear(scheme_ == Scheme::MUSL, has_rigid_);
     if (has_rigid_) mark_rigid_nodes();
+    if (contact_.active()) contact_.clear(grid_.nodes(), scheme_ == Scheme::MUSL);
   }
+  if (contact_.active())
+    scatter_to_grid<F, true>();
+  else
+    scatter_to_grid<F, false>();
+}
+
+/// The scatter of p2g; with contact (C), the particles of the bodies in contact add into
+/// their bodies' fields instead of the common one.
+template <Grid GridT>
+template <int F, bool C>
+void ExplicitSolver<GridT>::scatter_to_grid() {
+  constexpr bool kM = F & kMass, kP = F & kMomentum, kF = F & kForce;
   const ParticleView<D> p = view<D>(particles_);
   material_ = p.material;
   const auto& bins = binning_.bins();
@@ -65,6 +77,9 @@ void ExplicitSolver<GridT>::p2g() {
     Vec<D> xi;
     grid_.locate(p.x[i], key, xi);
     const int nn = grid_.cell_nodes(key, nodes);
+    if constexpr (C)
+      if (const int f = contact_.field_of(p.body[i]))
+        return add_to_field<F>(p, i, f, key, xi, nodes, nn);
     contribute(i, key, xi, nn, to_target(t, nodes));
   };
   auto bin_body = [&](int, std::uint32_t bi, const Target& t, std::vector<std::uint32_t>* strays) {
@@ -85,6 +100,19 @@ void ExplicitSolver<GridT>::p2g() {
       std::int64_t key;
       Vec<D> xi;
       locate_in_bin(bin.key, p.x[i], key, xi);
+      if constexpr (C) {
+        if (const int f = contact_.field_of(p.body[i])) {
+          if (key == bin.key || !strays || grid_.layer(key) == layer) {
+            std::int64_t other[NMAX];
+            const bool home = key == bin.key;
+            const int nk = home ? nn : grid_.cell_nodes(key, other);
+            add_to_field<F>(p, i, f, key, xi, home ? nodes : other, nk);
+          } else {
+            strays->push_back(i);
+          }
+          continue;
+        }
+      }
       if (key == bin.key) {
         contribute(i, key, xi, nn, to_cell);
       } else if (!strays || grid_.layer(key) == layer) {
@@ -103,6 +131,41 @@ void ExplicitSolver<GridT>::p2g() {
     }
   };
   scatter(F, bin_body, particle_body);  // scatter.hpp
+}
+
+template <Grid GridT>
+template <int F>
+void ExplicitSolver<GridT>::add_to_field(const ParticleView<D>& p, std::uint32_t i, int f,
+                                         std::int64_t key, const Vec<D>& xi, const std::int64_t* nd,
+                                         int nk) {
+  constexpr bool kM = F & kMass, kP = F & kMomentum, kF = F & kForce;
+  auto& fd = contact_.field(f);
+  double N[NMAX];
+  Vec<D> G[NMAX];
+  grid_.shape(key, xi, N, G);
+  const double m_p = p.m[i];
+  const Vec<D> mv_p = m_p * p.v[i];
+  for (int c = 0; c < nk; ++c) {
+    const std::int64_t n = nd[c];
+    if constexpr (kM) {
+      fd.m[n] += m_p * N[c];
+      fd.g[n] += m_p * G[c];             // the body's mass gradient: the contact normal
+      fd.x[n] += (m_p * N[c]) * p.x[i];  // its centre: the gap
+    }
+    if constexpr (kP) fd.v[n] += N[c] * mv_p;
+  }
+  if constexpr (kF) {
+    const double V = m_p / p.rho[i];
+    const Mat<D> Vsigma = V * to_matrix(p.sigma[i]).template topLeftCorner<D, D>();
+    const double Vs_hoop_r = axisymmetric_ ? V * p.sigma[i][2] / p.x[i][0] : 0.0;
+    Vec<D> fb = m_p * gravity_;
+    if (p.f_ext) fb += p.f_ext[i];
+    for (int c = 0; c < nk; ++c) {
+      Vec<D> df = N[c] * fb - Vsigma * G[c];         // (000, eqs. 4-5)
+      if (axisymmetric_) df[0] -= Vs_hoop_r * N[c];  // hoop stress
+      fd.a[nd[c]] += df;
+    }
+  }
 }
 
 // Rigid particles mark the nodes they touch with their body, serially:

@@ -17,17 +17,27 @@ void ExplicitSolver<GridT>::update_stress(const std::vector<Vec<D>>& v_grad, Pos
   material_ = p.material;
   const int nchunks = binning_.chunk_count();
   std::vector<ChunkSums> stats(nchunks);
+  const bool remapped = &v_grad == &grid_.v_remap;  // MUSL: the fields' remapped velocities
+  if (contact_.active()) {
 #pragma omp parallel for schedule(dynamic, 1)
-  for (int ch = 0; ch < nchunks; ++ch) stress_chunk(p, ch, v_grad.data(), positions, stats[ch]);
+    for (int ch = 0; ch < nchunks; ++ch)
+      stress_chunk<true>(p, ch, v_grad.data(), positions, remapped, stats[ch]);
+  } else {
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int ch = 0; ch < nchunks; ++ch)
+      stress_chunk<false>(p, ch, v_grad.data(), positions, remapped, stats[ch]);
+  }
   finish(stats, positions == Positions::Move ? kStresses | kPositions : kStresses);
 }
 
 /// The stress update of the particles of chunk ch from the grid velocities vg_i (flattened:
-/// every call but the material update's is inlined into its loop).
+/// every call but the material update's is inlined into its loop); with contact (C), the
+/// particles of bodies in contact take their fields' velocities (remapped: MUSL's).
 template <Grid GridT>
+template <bool C>
 [[gnu::flatten]] void ExplicitSolver<GridT>::stress_chunk(const ParticleView<D>& p, int ch,
                                                           const Vec<D>* vg_i, Positions positions,
-                                                          ChunkSums& s) {
+                                                          bool remapped, ChunkSums& s) {
   StressScratch& scr = *scratch_[omp_get_thread_num()];
   const Vec<D>* v_i = grid_.v.data();
   const auto& bins = binning_.bins();
@@ -61,11 +71,24 @@ template <Grid GridT>
       Mat<D> L = Mat<D>::Zero();
       Vec<D> vbar = Vec<D>::Zero();
       double v_r = 0;
+      // Nodal velocities cached for the particle: its bin's, or its body's field's (contact).
+      bool cached = home;
+      const Vec<D>*vg_h = vg_c, *v_h = v_c;
+      Vec<D> vg_f[C ? NMAX : 1], v_f[C ? NMAX : 1];
+      if constexpr (C)
+        if (const int f = contact_.field_of(p.body[i])) {
+          const auto& fd = contact_.field(f);
+          for (int c = 0; c < nk; ++c) {
+            vg_f[c] = remapped ? fd.q[nd[c]] : fd.v[nd[c]];
+            v_f[c] = fd.v[nd[c]];
+          }
+          cached = true, vg_h = vg_f, v_h = v_f;
+        }
       for (int c = 0; c < nk; ++c) {
-        const Vec<D>& vg = home ? vg_c[c] : vg_i[nd[c]];
+        const Vec<D>& vg = cached ? vg_h[c] : vg_i[nd[c]];
         L.noalias() += vg * G[c].transpose();
         if (axi) v_r += N[c] * vg[0];
-        if (move) vbar += N[c] * (home ? v_c[c] : v_i[nd[c]]);
+        if (move) vbar += N[c] * (cached ? v_h[c] : v_i[nd[c]]);
       }
       if (p.strain) p.strain[i] += dt * L.diagonal();  // for splitting (004, eq. 23)
       if (pb.ends_before(i, p.material[i], h_cell)) {
