@@ -85,6 +85,18 @@ struct CraterArgs {
 };
 int post_crater(const CraterArgs& args);
 
+/// mpm-post residual: a projectile's velocity through a target, its residual velocity, exit
+/// angle and mass lost to failure (ResidualMeter), as text or JSON; the history as CSV.
+struct ResidualArgs {
+  std::string input = "-";  ///< stream ("-": stdin)
+  std::string body;         ///< the projectile; empty: the fastest body at t = 0
+  std::string target;       ///< the target; empty: every other body
+  std::string output;       ///< CSV history file ("-": stdout); empty: none
+  std::string symmetry;     ///< mirror planes (option_symmetry); empty: the scene's
+  bool json = false;        ///< print JSON (SI units)
+};
+int post_residual(const ResidualArgs& args);
+
 /// mpm-post profile: a field along a line (make_profile) of one or more frames, CSV or JSON.
 struct ProfileArgs {
   std::string input = "-";         ///< stream ("-": stdin)
