@@ -151,6 +151,9 @@ CLI::App* add_residual(CLI::App& app, mpm::ResidualArgs& a) {
   sub->add_option("-o,--output", a.output,
                   "the history as CSV (time, velocity, along the initial direction, speed, "
                   "angle, mass, failed mass, tail), - for stdout");
+  sub->add_option("--plot", a.plot,
+                  "a PNG chart of the history (speed and along the initial direction against "
+                  "time, off-screen)");
   add_symmetry(sub, a.symmetry, "; the velocity is the whole body's");
   sub->add_flag("--json", a.json, "print JSON (SI units)");
   return sub;
@@ -279,6 +282,8 @@ int main(int argc, char** argv) {
     if (*render) mpm::check_output_file(render_args.output, {render_args.input});
     if (*residual && !residual_args.output.empty())
       mpm::check_output_file(residual_args.output, {residual_args.input});
+    if (*residual && !residual_args.plot.empty())
+      mpm::check_output_file(residual_args.plot, {residual_args.input});
     // Measures need a result: a model from mpm-prep is refused, naming what to run.
     if (*history) mpm::require_result(history_args.input, "history");
     if (*taylor) mpm::require_result(taylor_args.input, "taylor");
@@ -295,7 +300,14 @@ int main(int argc, char** argv) {
     if (*debris) return mpm::post_debris(debris_args);
     if (*profile) return mpm::post_profile(profile_args);
     if (*crater) return mpm::post_crater(crater_args);
-    if (*residual) return mpm::post_residual(residual_args);
+    if (*residual) {
+      if (residual_args.plot.empty()) return mpm::post_residual(residual_args);
+      mpm::ensure_display(argc, argv);  // before reading: a re-run under xvfb reads stdin again
+      return mpm::post_residual(residual_args,
+                                [](const mpm::ResidualResult& r, const std::string& png) {
+                                  mpm::plot_residual_png(r, png);
+                                });
+    }
     if (*render) {
       mpm::ensure_display(argc, argv);  // before reading: a re-run under xvfb reads stdin again
       return mpm::post_render(render_args);

@@ -5,6 +5,9 @@
 // and exit velocities, the exit frame, the angle and the mass lost to round-off. A half model
 // (mirror plane x = 0) with particles spreading along x: the whole body's x velocity is zero.
 #include <gtest/gtest.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPNGReader.h>
 
 #include <cmath>
 #include <numbers>
@@ -184,6 +187,40 @@ TEST(CliResidual, ResidualExitVelocityAngleAndMassLostOnAConstructedStream) {
   EXPECT_NE(t.out.find("Residual velocity of 'rod' through 'plate'"), std::string::npos) << t.out;
   EXPECT_NE(t.out.find("tail left the target at t = 70 us"), std::string::npos) << t.out;
   EXPECT_NE(t.out.find("mass lost to failure: 0.9 g of 18 g (5%)"), std::string::npos) << t.out;
+}
+
+// --plot: a 1200 x 800 PNG chart, drawn off-screen (under xvfb-run without a display), with
+// the blue speed line (31, 119, 180) running from the top left (575 m/s at t = 0) to the bottom
+// right (179.5 m/s at 400 us): its pixels in the left tenth lie above those in the right tenth.
+TEST(CliResidual, PlotIsAPngOfTheHistory) {
+  const auto dir = temp_dir("residual_plot");
+  const std::string stream = (dir / "result.mpm").string();
+  write_stream(stream, false);
+  const std::string png = (dir / "residual.png").string();
+  const auto r =
+      run("env -u DISPLAY " + testing::post + " residual " + stream + " --plot " + png, dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  vtkNew<vtkPNGReader> reader;
+  reader->SetFileName(png.c_str());
+  reader->Update();
+  vtkImageData* img = reader->GetOutput();
+  int dims[3];
+  img->GetDimensions(dims);
+  ASSERT_EQ(dims[0], 1200);
+  ASSERT_EQ(dims[1], 800);
+  double left = 0, right = 0;  // mean row (from the bottom) of the blue pixels
+  int n_left = 0, n_right = 0;
+  for (int y = 0; y < dims[1]; ++y)
+    for (int x = 0; x < dims[0]; ++x) {
+      const auto* px = static_cast<unsigned char*>(img->GetScalarPointer(x, y, 0));
+      if (std::abs(px[0] - 31) > 30 || std::abs(px[1] - 119) > 30 || std::abs(px[2] - 180) > 30)
+        continue;
+      if (x < dims[0] / 10) left += y, ++n_left;
+      if (x > 9 * dims[0] / 10) right += y, ++n_right;
+    }
+  ASSERT_GT(n_left, 0);
+  ASSERT_GT(n_right, 0);
+  EXPECT_GT(left / n_left, right / n_right + 0.4 * dims[1]);
 }
 
 TEST(CliResidual, UnknownBodyExitsTwoNamingItAndTheKnownOnes) {

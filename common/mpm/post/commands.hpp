@@ -6,6 +6,7 @@
 /// ended unstable. Reports go to stdout (or the output file), messages to stderr. Throws
 /// InputError/StreamError for bad input, IoError when an output cannot be written.
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -93,9 +94,14 @@ struct ResidualArgs {
   std::string target;       ///< the target; empty: every other body
   std::string output;       ///< CSV history file ("-": stdout); empty: none
   std::string symmetry;     ///< mirror planes (option_symmetry); empty: the scene's
+  std::string plot;         ///< PNG chart of the history; empty: none
   bool json = false;        ///< print JSON (SI units)
 };
-int post_residual(const ResidualArgs& args);
+struct ResidualResult;
+/// Draws a residual history into a PNG file (mpm-post passes plot_residual_png of post/vtk).
+using ResidualPlot = std::function<void(const ResidualResult&, const std::string& path)>;
+/// Throws std::logic_error when args.plot is given and `plot` is empty.
+int post_residual(const ResidualArgs& args, const ResidualPlot& plot = {});
 
 /// mpm-post profile: a field along a line (make_profile) of one or more frames, CSV or JSON.
 struct ProfileArgs {

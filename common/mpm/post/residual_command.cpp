@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <stdexcept>
 
 #include "mpm/core/error.hpp"
 #include "mpm/post/command_io.hpp"
@@ -106,7 +107,8 @@ void write_residual_csv(const ResidualResult& r, const std::string& path) {
 
 }  // namespace
 
-int post_residual(const ResidualArgs& a) {
+int post_residual(const ResidualArgs& a, const ResidualPlot& plot) {
+  if (!a.plot.empty() && !plot) throw std::logic_error("post_residual: --plot without a plotter");
   const std::string& path = a.input;
   ResidualOptions opt;
   opt.body = a.body;
@@ -133,6 +135,7 @@ int post_residual(const ResidualArgs& a) {
   }
   const ResidualResult& r = meter->result();
   if (!a.output.empty()) write_residual_csv(r, a.output);
+  if (!a.plot.empty()) plot(r, a.plot);
   if (a.json)
     print_residual_json(r);
   else
