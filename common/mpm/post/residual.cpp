@@ -96,7 +96,7 @@ ResidualMeter::ResidualMeter(const Scene& scene, const Frame& first,
   const Column& bc = need(first, col::body);
   r_.far_face = -1e300;
   for (std::size_t i = 0; i < first.columns.size(); ++i) {
-    const int b = int(body_id(bc, i));
+    const int b = int(column_value(bc, i, 0));
     if (std::find(target_bodies_.begin(), target_bodies_.end(), b) != target_bodies_.end())
       r_.far_face = std::max(r_.far_face, r_.sign * x[i * dim_ + r_.axis]);
   }
@@ -119,7 +119,7 @@ ResidualSample ResidualMeter::sample(const Frame& f) const {
   s.tail = 1e300;
   Vec3 p = Vec3::Zero();
   for (std::size_t i = 0; i < f.columns.size(); ++i) {
-    if (int(body_id(bc, i)) != body_) continue;
+    if (int(column_value(bc, i, 0)) != body_) continue;
     if (fc && column_value(*fc, i, 0) != 0) {
       s.failed_mass += m[i];
       continue;
