@@ -149,6 +149,25 @@ CLI::App* add_crater(CLI::App& app, mpm::CraterArgs& a) {
   return sub;
 }
 
+CLI::App* add_residual(CLI::App& app, mpm::ResidualArgs& a) {
+  auto* sub = app.add_subcommand(
+      "residual",
+      "a projectile's velocity through a target: residual velocity when its tail has left the "
+      "target and at the end, exit angle, mass lost to failure");
+  sub->add_option("input", a.input, "stream, - for stdin")->capture_default_str();
+  sub->add_option("--body", a.body, "the projectile (default: the fastest body at t = 0)");
+  sub->add_option("--target", a.target, "the target body (default: every other body)");
+  sub->add_option("-o,--output", a.output,
+                  "the history as CSV (time, velocity, along the initial direction, speed, "
+                  "angle, mass, failed mass, tail), - for stdout");
+  sub->add_option("--plot", a.plot,
+                  "a PNG chart of the history (speed and along the initial direction against "
+                  "time, off-screen)");
+  add_symmetry(sub, a.symmetry, "; the velocity is the whole body's");
+  sub->add_flag("--json", a.json, "print JSON (SI units)");
+  return sub;
+}
+
 CLI::App* add_profile(CLI::App& app, mpm::ProfileArgs& a) {
   auto* sub =
       app.add_subcommand("profile", "a field along a line (stress waves, shocks), CSV or JSON");
@@ -248,6 +267,7 @@ int main(int argc, char** argv) {
   mpm::ProfileArgs profile_args;
   mpm::CraterArgs crater_args;
   mpm::RenderArgs render_args;
+  mpm::ResidualArgs residual_args;
   const auto* summary = add_summary(app, summary_args);
   const auto* scene = add_scene(app, scene_args);
   const auto* history = add_history(app, history_args);
@@ -258,6 +278,7 @@ int main(int argc, char** argv) {
   const auto* profile = add_profile(app, profile_args);
   const auto* crater = add_crater(app, crater_args);
   const auto* render = add_render(app, render_args);
+  const auto* residual = add_residual(app, residual_args);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -272,6 +293,10 @@ int main(int argc, char** argv) {
     if (*particles) mpm::check_output_file(particles_args.output, {particles_args.input});
     if (*profile) mpm::check_output_file(profile_args.output, {profile_args.input});
     if (*render) mpm::check_output_file(render_args.output, {render_args.input});
+    if (*residual && !residual_args.output.empty())
+      mpm::check_output_file(residual_args.output, {residual_args.input});
+    if (*residual && !residual_args.plot.empty())
+      mpm::check_output_file(residual_args.plot, {residual_args.input});
     // Measures need a result: a model from mpm-prep is refused, naming what to run.
     if (*history) mpm::require_result(history_args.input, "history");
     if (*taylor) mpm::require_result(taylor_args.input, "taylor");
@@ -279,6 +304,7 @@ int main(int argc, char** argv) {
     if (*crater) mpm::require_result(crater_args.input, "crater");
     if (*profile) mpm::require_result(profile_args.input, "profile");
     if (*render) mpm::require_result(render_args.input, "render");
+    if (*residual) mpm::require_result(residual_args.input, "residual");
     if (*summary) return mpm::post_summary(summary_args);
     if (*scene) return mpm::post_scene(scene_args);
     if (*history) return mpm::post_history(history_args);
@@ -288,6 +314,14 @@ int main(int argc, char** argv) {
     if (*debris) return mpm::post_debris(debris_args);
     if (*profile) return mpm::post_profile(profile_args);
     if (*crater) return mpm::post_crater(crater_args);
+    if (*residual) {
+      if (residual_args.plot.empty()) return mpm::post_residual(residual_args);
+      mpm::ensure_display(argc, argv);  // before reading: a re-run under xvfb reads stdin again
+      return mpm::post_residual(residual_args,
+                                [](const mpm::ResidualResult& r, const std::string& png) {
+                                  mpm::plot_residual_png(r, png);
+                                });
+    }
     if (*render) {
       mpm::ensure_display(argc, argv);  // before reading: a re-run under xvfb reads stdin again
       return mpm::post_render(render_args);

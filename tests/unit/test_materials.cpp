@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "mpm/scene/particles.hpp"
 #include "mpm/solver/materials/material.hpp"
 
 namespace mpm {
@@ -74,7 +75,8 @@ struct Point {
 
 TEST(Materials, RegistryBuildsEveryModelByKey) {
   const ModelRegistry& r = model_registry();
-  for (const char* k : {"elastic", "j2", "johnson-cook"}) EXPECT_TRUE(r.strength.count(k)) << k;
+  for (const char* k : {"elastic", "j2", "johnson-cook", "bilinear"})
+    EXPECT_TRUE(r.strength.count(k)) << k;
   for (const char* k : {"linear", "mie-gruneisen"}) EXPECT_TRUE(r.eos.count(k)) << k;
   MaterialSpec m = copper();
   EXPECT_TRUE(r.strength.at("j2")(m)->needs_plastic_strain());
@@ -465,6 +467,143 @@ TEST(Materials, HugoniotStateOfTheShockEstimate) {
   EXPECT_EQ(mat.shocked_signal_speed(0.0), c0);
   EXPECT_GT(mat.shocked_signal_speed(50.0), c0 + 50.0);
   EXPECT_GT(mat.shocked_signal_speed(3290.0), mat.shocked_signal_speed(1000.0));
+}
+
+/// V6's projectile steel (004 Table 7): bilinear, sigma_y = 1.43 GPa, E_T = 14.759 GPa.
+MaterialSpec v6_steel() {
+  MaterialSpec m = solid("steel", 7850, 202e9, 0.3);
+  m.strength.model = StrengthModel::Bilinear;
+  m.strength.A = 1.43e9;
+  m.strength.tangent_modulus = 14.759e9;
+  return m;
+}
+
+// Bilinear, isochoric path D = rate diag(1, -1/2, -1/2) as in
+// J2ReturnMappingFollowsTheAnalyticCurve: q = 3 G eps, then q = (A + H eps) / (1 + H / (3G)) with H
+// = E E_T / (E - E_T) = 16.0 GPa. Radial return with linear hardening is exact on this path:
+// round-off.
+TEST(Materials, BilinearIsochoricPathHasHardeningModulusFromTheTangentModulus) {
+  const MaterialSpec spec = v6_steel();
+  const auto s = model_registry().strength.at("bilinear")(spec);
+  EXPECT_TRUE(s->needs_plastic_strain());
+  EXPECT_FALSE(s->needs_temperature());
+  const double E = spec.youngs_modulus, E_T = spec.strength.tangent_modulus;
+  const double H = E * E_T / (E - E_T), A = spec.strength.A, G = spec.shear_modulus();
+  EXPECT_NEAR(s->flow_stress(0.1, 1e5, 1000), A + H * 0.1, 1e-6 * A);  // no rate or thermal term
+  const Material mat(spec, no_viscosity());
+  Point p(spec.density);
+  const double rate = 1e3, dt = 1e-7;
+  Mat3 L = Mat3::Zero();
+  L(0, 0) = rate;
+  L(1, 1) = L(2, 2) = -0.5 * rate;
+  for (int k = 1; k <= 1000; ++k) {
+    p.update(mat, L, dt);
+    const double eps = rate * dt * k;
+    const double q_exact = 3 * G * eps <= A ? 3 * G * eps : (A + H * eps) / (1 + H / (3 * G));
+    ASSERT_NEAR(von_mises(p.sigma), q_exact, 1e-9 * q_exact + 1.0) << "step " << k;
+  }
+  EXPECT_GT(p.eps_p, 0.08);  // 0.1 less the elastic strain q / 3G
+}
+
+// Bilinear, true uniaxial stress (the lateral rate found each step so that sigma_yy = 0), to
+// 3% strain: sigma = E eps to the yield point eps_y = sigma_y / E = 0.71%, then sigma =
+// sigma_y + E_T (eps - eps_y). eps is the log strain the rate-form update integrates; the
+// linear EOS's p = K (rho / rho0 - 1) differs from K times the log volume strain eps_v by
+// K eps_v^2 / 2 (eps_v <= (1 - 2 nu) 3% here: at most 0.06% of sigma), so the curve is matched
+// within 0.1% of sigma. The slope past yield is E_T within 1% (the EOS's curvature again).
+TEST(Materials, BilinearUniaxialStressCurve) {
+  const MaterialSpec spec = v6_steel();
+  const Material mat(spec, no_viscosity());
+  const double E = spec.youngs_modulus, E_T = spec.strength.tangent_modulus, sy = spec.strength.A;
+  Point p(spec.density);
+  const double rate = 1e3, dt = 1e-7;
+  double sig_1pc = 0, sig_3pc = 0;
+  for (int k = 1; k <= 300; ++k) {
+    auto lateral = [&](double l) {
+      Point q = p;
+      Mat3 L = Mat3::Zero();
+      L(0, 0) = rate;
+      L(1, 1) = L(2, 2) = l;
+      q.update(mat, L, dt);
+      return q;
+    };
+    double l0 = -0.3 * rate, l1 = -0.5 * rate;
+    double f0 = lateral(l0).sigma[1], f1 = lateral(l1).sigma[1];
+    for (int it = 0; it < 30 && std::abs(f1) > 1e-3; ++it) {
+      const double l2 = l1 - f1 * (l1 - l0) / (f1 - f0);
+      l0 = l1, f0 = f1, l1 = l2, f1 = lateral(l1).sigma[1];
+    }
+    p = lateral(l1);
+    const double eps = rate * dt * k;
+    const double sig_exact = E * eps <= sy ? E * eps : sy + E_T * (eps - sy / E);
+    ASSERT_NEAR(p.sigma[0], sig_exact, 1e-3 * sig_exact) << "eps " << eps;
+    ASSERT_NEAR(p.sigma[1], 0.0, 1e-3) << "eps " << eps;
+    if (k == 100) sig_1pc = p.sigma[0];
+    if (k == 300) sig_3pc = p.sigma[0];
+  }
+  EXPECT_NEAR((sig_3pc - sig_1pc) / 0.02, E_T, 0.01 * E_T);
+  EXPECT_NEAR(p.eps_p, 0.03 - p.sigma[0] / E, 1e-3 * 0.03);
+}
+
+// Johnson-Cook's thermal softening with the temperature from plastic work: each plastic step
+// raises T by taylor_quinney x (the step's plastic work per volume, the flow stress times the
+// plastic strain increment) / (rho c), and the flow stress of the step is (A + B eps_p) (1 -
+// T*^m) at the temperature the step started from. Both to round-off. A strength model without
+// thermal softening leaves T alone even where the column exists (another material needs it).
+TEST(Materials, JohnsonCookAdiabaticTemperatureRiseIsTheTaylorQuinneyShareOfPlasticWork) {
+  MaterialSpec spec = copper();
+  spec.strength.model = StrengthModel::JohnsonCook;
+  spec.strength.m = 1.09;
+  spec.strength.melt_temperature = 1356;
+  spec.strength.specific_heat = 383;
+  spec.strength.taylor_quinney = 0.85;
+  const Material mat(spec, no_viscosity());
+  const StrengthSpec& s = spec.strength;
+  Point p(spec.density);
+  Mat3 L = Mat3::Zero();
+  L(0, 0) = 1e4;
+  L(1, 1) = L(2, 2) = -0.5e4;
+  double T_expected = p.T, work = 0;
+  for (int k = 0; k < 3000; ++k) {
+    const double T0 = p.T, ep0 = p.eps_p;
+    p.update(mat, L, 1e-7, true);
+    const double dep = p.eps_p - ep0, q = von_mises(p.sigma);
+    if (dep > 0) {
+      const double Ts = (T0 - s.room_temperature) / (s.melt_temperature - s.room_temperature);
+      ASSERT_NEAR(q, (s.A + s.B * p.eps_p) * (1 - std::pow(Ts, s.m)), 1e-9 * q) << "step " << k;
+    }
+    work += q * dep / p.rho;  // J/kg (isochoric: rho stays rho0)
+    T_expected += s.taylor_quinney * q * dep / (p.rho * s.specific_heat);
+    ASSERT_NEAR(p.T, T_expected, 1e-9 * T_expected) << "step " << k;
+  }
+  EXPECT_GT(p.eps_p, 2.5);
+  // Half a kelvin per percent at first: hundreds of kelvin by eps_p = 2.5, and softening shows.
+  EXPECT_NEAR(p.T - 293, 0.85 * work / 383, 1e-9 * p.T);
+  EXPECT_GT(p.T - 293, 300);
+  EXPECT_LT(von_mises(p.sigma), 0.8 * (s.A + s.B * p.eps_p));
+
+  // j2 (and bilinear) with a temperature column: T stays where it was.
+  for (const MaterialSpec& other : {copper(), v6_steel()}) {
+    const Material cold(other, no_viscosity());
+    Point c(other.density);
+    for (int k = 0; k < 300; ++k) c.update(cold, L, 1e-7, true);
+    EXPECT_GT(c.eps_p, 0.2);
+    EXPECT_EQ(c.T, 293);
+  }
+}
+
+// The temperature column exists only when a material has thermal softening (Johnson-Cook with
+// m > 0); plastic strain with any plastic model.
+TEST(Materials, TemperatureColumnOnlyWithThermalSoftening) {
+  Scene scene;
+  scene.materials = {copper(), v6_steel()};
+  ColumnNeeds need = column_needs(scene);
+  EXPECT_TRUE(need.eps_p);
+  EXPECT_FALSE(need.T);
+  scene.materials[0].strength.model = StrengthModel::JohnsonCook;  // m = 0: no thermal term
+  EXPECT_FALSE(column_needs(scene).T);
+  scene.materials[0].strength.m = 1.09;
+  EXPECT_TRUE(column_needs(scene).T);
 }
 
 }  // namespace

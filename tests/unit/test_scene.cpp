@@ -560,7 +560,28 @@ TEST(SceneErrors, InlineCases) {
        "materials.copper.strength.C: not used by the j2 model (only by \"johnson-cook\")"},
       {"unknown strength model", mat_end, mat_end + "\nstrength.model = \"jc\"", "strength",
        "materials.copper.strength.model: expected one of \"elastic\", \"j2\", \"johnson-cook\", "
-       "got 'jc'"},
+       "\"bilinear\", got 'jc'"},
+      {"bilinear with A", mat_end,
+       mat_end + "\n[materials.copper.strength]\nmodel = \"bilinear\"\nyield_stress = "
+                 "\"1.43 GPa\"\ntangent_modulus = \"14.759 GPa\"\nA = 1e8",
+       "A = 1e8",
+       "materials.copper.strength.A: not used by the bilinear model (its keys: yield_stress, "
+       "tangent_modulus)"},
+      {"bilinear without tangent modulus", mat_end,
+       mat_end + "\n[materials.copper.strength]\nmodel = \"bilinear\"\nyield_stress = 1e8",
+       "[materials.copper.strength]",
+       "materials.copper.strength: missing required key 'tangent_modulus' (a pressure, e.g. "
+       "\"14.759 GPa\"; the slope after yield, below youngs_modulus)"},
+      {"bilinear tangent above E", mat_end,
+       mat_end + "\n[materials.copper.strength]\nmodel = \"bilinear\"\nyield_stress = "
+                 "1e8\ntangent_modulus = \"117 GPa\"",
+       "tangent_modulus",
+       "materials.copper.strength.tangent_modulus: must be below youngs_modulus (1.17e+11 Pa)"},
+      {"j2 with tangent modulus", mat_end,
+       mat_end + "\n[materials.copper.strength]\nmodel = \"j2\"\nA = 1e8\ntangent_modulus = 1e9",
+       "tangent_modulus",
+       "materials.copper.strength.tangent_modulus: not used by the j2 model (only by "
+       "\"bilinear\")"},
       {"thermal JC without melt temperature", mat_end,
        mat_end + "\n[materials.copper.strength]\nmodel = \"johnson-cook\"\nA = 1e8\nm = 1\n"
                  "specific_heat = 383",

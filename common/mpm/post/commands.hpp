@@ -6,6 +6,7 @@
 /// ended unstable. Reports go to stdout (or the output file), messages to stderr. Throws
 /// InputError/StreamError for bad input, IoError when an output cannot be written.
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -92,6 +93,23 @@ struct CraterArgs {
   bool json = false;        ///< print JSON (SI units)
 };
 int post_crater(const CraterArgs& args);
+
+/// mpm-post residual: a projectile's velocity through a target, its residual velocity, exit
+/// angle and mass lost to failure (ResidualMeter), as text or JSON; the history as CSV.
+struct ResidualArgs {
+  std::string input = "-";  ///< stream ("-": stdin)
+  std::string body;         ///< the projectile; empty: the fastest body at t = 0
+  std::string target;       ///< the target; empty: every other body
+  std::string output;       ///< CSV history file ("-": stdout); empty: none
+  std::string symmetry;     ///< mirror planes (option_symmetry); empty: the scene's
+  std::string plot;         ///< PNG chart of the history; empty: none
+  bool json = false;        ///< print JSON (SI units)
+};
+struct ResidualResult;
+/// Draws a residual history into a PNG file (mpm-post passes plot_residual_png of post/vtk).
+using ResidualPlot = std::function<void(const ResidualResult&, const std::string& path)>;
+/// Throws std::logic_error when args.plot is given and `plot` is empty.
+int post_residual(const ResidualArgs& args, const ResidualPlot& plot = {});
 
 /// mpm-post profile: a field along a line (make_profile) of one or more frames, CSV or JSON.
 struct ProfileArgs {

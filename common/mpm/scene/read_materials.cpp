@@ -15,7 +15,8 @@ namespace {
 void read_strength(Reader& r, StrengthSpec& s) {
   s.model = r.choice<StrengthModel>("model", {{"elastic", StrengthModel::Elastic},
                                               {"j2", StrengthModel::J2},
-                                              {"johnson-cook", StrengthModel::JohnsonCook}})
+                                              {"johnson-cook", StrengthModel::JohnsonCook},
+                                              {"bilinear", StrengthModel::Bilinear}})
                 .value_or(StrengthModel::Elastic);
   const std::initializer_list<std::string_view> jc_only = {"C",
                                                            "reference_rate",
@@ -24,12 +25,26 @@ void read_strength(Reader& r, StrengthSpec& s) {
                                                            "melt_temperature",
                                                            "specific_heat",
                                                            "taylor_quinney"};
+  const std::initializer_list<std::string_view> bilinear_only = {"yield_stress", "tangent_modulus"};
   if (s.model == StrengthModel::Elastic) {
     r.reject({"A", "B", "n"}, "by the elastic model (set model = \"j2\" or \"johnson-cook\")");
     r.reject(jc_only, "by the elastic model (set model = \"johnson-cook\")");
+    r.reject(bilinear_only, "by the elastic model (set model = \"bilinear\")");
     r.finish();
     return;
   }
+  if (s.model == StrengthModel::Bilinear) {
+    s.A = r.required("yield_stress", dim::pressure, Bound::NonNegative, "1.43 GPa");
+    s.tangent_modulus = r.required("tangent_modulus", dim::pressure, Bound::NonNegative,
+                                   "14.759 GPa", "the slope after yield, below youngs_modulus");
+    r.reject({"A", "B", "n"}, "by the bilinear model (its keys: yield_stress, tangent_modulus)");
+    r.reject(jc_only, "by the bilinear model (only by \"johnson-cook\")");
+    r.finish();
+    return;
+  }
+  r.reject(bilinear_only, "by the " +
+                              std::string(s.model == StrengthModel::J2 ? "j2" : "johnson-cook") +
+                              " model (only by \"bilinear\")");
   s.A = r.required("A", dim::pressure, Bound::NonNegative, "157 MPa");
   s.B = r.quantity("B", dim::pressure, Bound::NonNegative).value_or(0.0);
   s.n = r.number("n", Bound::Positive).value_or(1.0);
@@ -174,11 +189,15 @@ MaterialSpec read_material(Reader& r, const std::string& name, std::vector<std::
   r.check("poisson_ratio", m.poisson_ratio < 0.5,
           "must be below 0.5 (incompressible materials are not supported)");
   SourceLoc yield_at, c0_at;
-  if (auto t = r.table("strength",
-                       {"model", "A", "B", "n", "C", "reference_rate", "m", "room_temperature",
-                        "melt_temperature", "specific_heat", "taylor_quinney"})) {
+  if (auto t = r.table("strength", {"model", "A", "B", "n", "C", "reference_rate", "m",
+                                    "room_temperature", "melt_temperature", "specific_heat",
+                                    "taylor_quinney", "yield_stress", "tangent_modulus"})) {
     read_strength(*t, m.strength);
-    yield_at = t->loc_of("A");
+    const bool bilinear = m.strength.model == StrengthModel::Bilinear;
+    yield_at = t->loc_of(bilinear ? "yield_stress" : "A");
+    if (bilinear)
+      t->check("tangent_modulus", m.strength.tangent_modulus < m.youngs_modulus,
+               "must be below youngs_modulus (" + format_number(m.youngs_modulus) + " Pa)");
   }
   if (auto t = r.table("eos", {"model", "c0", "s", "gamma0", "energy_in_expansion", "a", "b", "A",
                                "B", "E0", "E_iv", "E_cv", "alpha", "beta"})) {

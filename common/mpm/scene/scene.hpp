@@ -19,14 +19,16 @@ struct SourceLoc {
   std::string key;  ///< dotted path, e.g. "materials.copper.density"
 };
 
-enum class StrengthModel { Elastic, J2, JohnsonCook };
+enum class StrengthModel { Elastic, J2, JohnsonCook, Bilinear };
 enum class EosModel { Linear, MieGruneisen, Tillotson };
 
 /// Deviatoric strength. J2: sigma_y = A + B eps_p^n. Johnson-Cook multiplies by
-/// (1 + C ln(rate/rate0)) (1 - T*^m), T* = (T - T_room)/(T_melt - T_room).
+/// (1 + C ln(rate/rate0)) (1 - T*^m), T* = (T - T_room)/(T_melt - T_room). Bilinear: J2 with
+/// sigma_y = A + H eps_p, H = E E_T / (E - E_T), so that the uniaxial curve bends from slope E
+/// to slope E_T at A.
 struct StrengthSpec {
   StrengthModel model = StrengthModel::Elastic;
-  double A = 0;                      ///< initial yield stress, Pa
+  double A = 0;                      ///< initial yield stress, Pa (bilinear: yield_stress)
   double B = 0;                      ///< hardening modulus, Pa
   double n = 1;                      ///< hardening exponent
   double C = 0;                      ///< strain-rate coefficient (Johnson-Cook)
@@ -36,6 +38,7 @@ struct StrengthSpec {
   double melt_temperature = 1356.0;  ///< K
   double specific_heat = 383.0;      ///< J/(kg K)
   double taylor_quinney = 0.9;       ///< fraction of plastic work turned into heat
+  double tangent_modulus = 0;        ///< bilinear: E_T, the uniaxial slope after yield, Pa
   bool thermal() const { return model == StrengthModel::JohnsonCook && m > 0; }
 };
 

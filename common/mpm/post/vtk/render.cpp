@@ -390,29 +390,6 @@ std::string caption(const ViewAxes& view, const Section& section, const Drawn& d
   return text;
 }
 
-/// Renders the window once and writes its back buffer as a PNG through a FileTarget.
-void write_png(vtkRenderWindow* window, const std::string& path) {
-  // The filter renders the window once (its ShouldRerender) and reads the back buffer.
-  vtkNew<vtkWindowToImageFilter> grab;
-  grab->SetInput(window);
-  grab->SetInputBufferTypeToRGB();
-  grab->ReadFrontBufferOff();
-  grab->Update();
-  FileTarget target(path);
-  vtkNew<vtkPNGWriter> png;
-  vtkNew<ErrorCatcher> png_errors, pipeline_errors;
-  png->AddObserver(vtkCommand::ErrorEvent, png_errors);
-  png->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, pipeline_errors);
-  png->SetInputConnection(grab->GetOutputPort());
-  png->SetFileName(target.write_path().c_str());
-  png->Write();
-  if (png->GetErrorCode() != 0 || !png_errors->message.empty() || !pipeline_errors->message.empty())
-    throw IoError("cannot write " + path + ": " +
-                  writer_failure(*png_errors, png->GetErrorCode(), *pipeline_errors,
-                                 target.write_path(), path));
-  target.commit();
-}
-
 }  // namespace
 
 void render_png(const Frame& frame, int dim, const RenderOptions& options,

@@ -7,8 +7,11 @@
 #include <vtkExecutive.h>
 #include <vtkFieldData.h>
 #include <vtkNew.h>
+#include <vtkPNGWriter.h>
+#include <vtkRenderWindow.h>
 #include <vtkTypeInt64Array.h>
 #include <vtkUnstructuredGrid.h>
+#include <vtkWindowToImageFilter.h>
 #include <vtkXMLUnstructuredGridWriter.h>
 
 #include <cerrno>
@@ -124,6 +127,29 @@ void write_unstructured(vtkUnstructuredGrid* grid, double time, std::int64_t ste
       !pipeline_errors->message.empty())
     throw IoError("cannot write " + path + ": " +
                   writer_failure(*errors, writer->GetErrorCode(), *pipeline_errors,
+                                 target.write_path(), path));
+  target.commit();
+}
+
+/// Renders the window once and writes its back buffer as a PNG through a FileTarget.
+void write_png(vtkRenderWindow* window, const std::string& path) {
+  // The filter renders the window once (its ShouldRerender) and reads the back buffer.
+  vtkNew<vtkWindowToImageFilter> grab;
+  grab->SetInput(window);
+  grab->SetInputBufferTypeToRGB();
+  grab->ReadFrontBufferOff();
+  grab->Update();
+  FileTarget target(path);
+  vtkNew<vtkPNGWriter> png;
+  vtkNew<ErrorCatcher> png_errors, pipeline_errors;
+  png->AddObserver(vtkCommand::ErrorEvent, png_errors);
+  png->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, pipeline_errors);
+  png->SetInputConnection(grab->GetOutputPort());
+  png->SetFileName(target.write_path().c_str());
+  png->Write();
+  if (png->GetErrorCode() != 0 || !png_errors->message.empty() || !pipeline_errors->message.empty())
+    throw IoError("cannot write " + path + ": " +
+                  writer_failure(*png_errors, png->GetErrorCode(), *pipeline_errors,
                                  target.write_path(), path));
   target.commit();
 }

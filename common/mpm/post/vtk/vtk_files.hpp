@@ -7,6 +7,7 @@
 #include <string>
 
 class vtkUnstructuredGrid;
+class vtkRenderWindow;
 
 namespace mpm::vtk_internal {
 
@@ -52,5 +53,9 @@ class FileTarget {
 /// "TIME", "TimeValue" (s) and "CYCLE" (step), through a FileTarget. Throws IoError.
 void write_unstructured(vtkUnstructuredGrid* grid, double time, std::int64_t step,
                         const std::string& path);
+
+/// Renders the window once and writes its back buffer as a PNG through a FileTarget. Throws
+/// IoError.
+void write_png(vtkRenderWindow* window, const std::string& path);
 
 }  // namespace mpm::vtk_internal

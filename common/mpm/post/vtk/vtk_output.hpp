@@ -9,7 +9,8 @@
 
 namespace mpm {
 
-struct GridMesh;  // stream/grid_record.hpp
+struct GridMesh;        // stream/grid_record.hpp
+struct ResidualResult;  // post/residual.hpp
 
 /// Writes a frame as a VTK XML unstructured grid (.vtu) of vertex cells, one per particle,
 /// with every column but "x" as point data of its own type (u8 -> vtkUnsignedCharArray,
@@ -63,6 +64,13 @@ struct RenderOptions {
 /// Throws InputError for an unknown field (listing the available ones), bad options, or no
 /// X display that can be opened; IoError when the PNG cannot be written.
 void render_png(const Frame& frame, int dim, const RenderOptions& options, const std::string& path);
+
+/// A chart of a projectile's velocity against time (mpm-post residual --plot): its speed and
+/// the component along its initial direction, the exit marked, as a PNG of width x height
+/// pixels. Needs an X server (ensure_display). Throws InputError when there is no display,
+/// IoError when the PNG cannot be written.
+void plot_residual_png(const ResidualResult& result, const std::string& path, int width = 1200,
+                       int height = 800);
 
 /// On a machine with no DISPLAY, re-runs this process (/proc/self/exe with argv[1..]) under
 /// `xvfb-run -a` (once; guarded by MPM_UNDER_XVFB) so that VTK's off-screen rendering has an

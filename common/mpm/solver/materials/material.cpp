@@ -66,6 +66,8 @@ std::string to_string(StrengthModel m) {
       return "j2";
     case StrengthModel::JohnsonCook:
       return "johnson-cook";
+    case StrengthModel::Bilinear:
+      return "bilinear";
   }
   return "?";
 }
@@ -87,6 +89,7 @@ const ModelRegistry& model_registry() {
     r.strength["elastic"] = make_elastic_strength;
     r.strength["j2"] = make_j2_strength;
     r.strength["johnson-cook"] = make_johnson_cook_strength;
+    r.strength["bilinear"] = make_bilinear_strength;
     r.eos["linear"] = make_linear_eos;
     r.eos["mie-gruneisen"] = make_mie_gruneisen_eos;
     r.eos["tillotson"] = make_tillotson_eos;

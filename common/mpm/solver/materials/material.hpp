@@ -191,7 +191,8 @@ struct ModelRegistry {
   std::map<std::string, StrengthFactory> strength;
   std::map<std::string, EosFactory> eos;
 };
-/// The registry with every built-in model: strength "elastic", "j2", "johnson-cook";
+/// The registry with every built-in model: strength "elastic", "j2", "johnson-cook",
+/// "bilinear";
 /// eos "linear", "mie-gruneisen", "tillotson".
 const ModelRegistry& model_registry();
 /// Registry key of a scene enum.

@@ -14,4 +14,6 @@ std::unique_ptr<Strength> make_elastic_strength(const MaterialSpec& m);
 std::unique_ptr<Strength> make_j2_strength(const MaterialSpec& m);
 /// Johnson-Cook: (A + B eps_p^n)(1 + C ln(rate/rate0))(1 - T*^m), adiabatic heating.
 std::unique_ptr<Strength> make_johnson_cook_strength(const MaterialSpec& m);
+/// Bilinear elastic-plastic: J2 with sigma_y = A + H eps_p, H = E E_T / (E - E_T).
+std::unique_ptr<Strength> make_bilinear_strength(const MaterialSpec& m);
 }  // namespace mpm

@@ -1,4 +1,4 @@
-// Strength models: elastic, J2 with power-law hardening, Johnson-Cook. Radial return.
+// Strength models: elastic, J2 with power-law hardening, Johnson-Cook, bilinear. Radial return.
 #include <algorithm>
 #include <cmath>
 
@@ -88,7 +88,9 @@ class PowerLawPlasticity final : public Strength {
       S.dlambda[i] = dl;
       S.yield[i] = sy;
       b.eps_p[i] = ep + dl;
-      if (b.T) b.T[i] += chi_ * sy * dl / (b.rho[i] * cv_);  // adiabatic heating
+      // Adiabatic heating, in models with thermal softening only (the others have no specific
+      // heat, and their T, there when another material needs it, stays at room temperature).
+      if (b.T && m_ > 0) b.T[i] += chi_ * sy * dl / (b.rho[i] * cv_);
     }
   }
 
@@ -134,6 +136,15 @@ std::unique_ptr<Strength> make_j2_strength(const MaterialSpec& m) {
 }
 std::unique_ptr<Strength> make_johnson_cook_strength(const MaterialSpec& m) {
   return std::make_unique<PowerLawPlasticity>(m.strength, true);
+}
+std::unique_ptr<Strength> make_bilinear_strength(const MaterialSpec& m) {
+  // Uniaxial stress: d sigma = E (d eps - d eps_p) and d sigma = H d eps_p give the slope
+  // E H / (E + H) after yield; it is E_T for H = E E_T / (E - E_T).
+  StrengthSpec s = m.strength;
+  const double E = m.youngs_modulus, E_T = s.tangent_modulus;
+  s.B = E * E_T / (E - E_T);
+  s.n = 1.0;
+  return std::make_unique<PowerLawPlasticity>(s, false);
 }
 
 }  // namespace mpm
