@@ -101,5 +101,23 @@ TEST(FuzzFindings, FrameClaimingMoreParticlesThanTheFileHoldsIsATruncation) {
       << message;
 }
 
+// An OFF face line "-1 0 0" (a negative vertex count): CGAL's OFF scanner converts the count
+// from double to size_t unchecked, undefined behaviour (UBSan: File_scanner_OFF.h:718). The
+// faces are now checked before CGAL reads the file, and a bad count or index named by its line.
+TEST(FuzzFindings, OffFaceWithANegativeCountIsRefusedByLine) {
+  const std::string message =
+      feed(mesh, bytes_of(kCorpus / "mesh" / "finding_off_negative_count.off"));
+  EXPECT_NE(message.find("fuzz.toml:1: bodies.part.file: mesh '"), std::string::npos) << message;
+  EXPECT_NE(message.find("mesh.off' line 14: a face line must start with its number of vertices "
+                         "and list that many vertex indices; found '-1 0 0'"),
+            std::string::npos)
+      << message;
+  const std::string off = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 -2\n";
+  EXPECT_NE(feed(mesh, off).find("line 6: vertex index 3 of the face is not a vertex number from 0 "
+                                 "to 2; found '3 0 1 -2'"),
+            std::string::npos)
+      << feed(mesh, off);
+}
+
 }  // namespace
 }  // namespace mpm::fuzz

@@ -30,6 +30,7 @@
 #include "mpm/core/error.hpp"
 #include "mpm/core/units.hpp"
 #include "mpm/prep/body_placement.hpp"
+#include "mpm/prep/mesh_file_checks.hpp"
 
 // Several OpenMP threads query one AABB tree. CGAL guards its lazily built structures only
 // when it knows threads exist; without CGAL_HAS_THREADS it may use unguarded statics.
@@ -78,6 +79,7 @@ Mesh read_placed_mesh(const BodySpec& body, const Scene& scene) {
 
   std::vector<Point> points;
   std::vector<std::vector<std::size_t>> polygons;
+  if (ext == ".off") check_off_faces(path, at, name);
   bool ok = false;
   try {
     ok = CGAL::IO::read_polygon_soup(path, points, polygons, CGAL::parameters::verbose(false));
