@@ -165,7 +165,10 @@ std::string describe_holes(const Mesh& mesh, const BodySpec& body) {
     ++holes;
     Vec3 c = Vec3::Zero();
     std::size_t edges = 0;
-    for (auto g : CGAL::halfedges_around_face(h, mesh)) {
+    // Along the border by next(), stopping at an edge already walked: a hole's cycle need
+    // not come back to h on a mesh the soup repair left odd (a loop that never did was found
+    // by fuzz_mesh), so each border edge is walked once at most.
+    for (auto g = h; mesh.is_border(g) && !seen[g.idx()]; g = mesh.next(g)) {
       seen[g.idx()] = true;
       const Point& p = mesh.point(mesh.target(g));
       c += Vec3(p.x(), p.y(), p.z());
