@@ -129,5 +129,15 @@ TEST(FuzzFindings, OpenMeshWhoseBorderLoopsIsRefusedAtOnce) {
   EXPECT_NE(message.find("mesh.obj' is not closed: "), std::string::npos) << message;
 }
 
+// A GRID record (CRC corrected by the harness) with an empty section: decode_grid copied zero
+// bytes into an empty vector's null data(), undefined behaviour (UBSan: grid_record.cpp:54).
+// Empty sections are skipped; the stream is read to its first damage.
+TEST(FuzzFindings, GridRecordWithAnEmptySectionDecodes) {
+  const std::string b = bytes_of(kCorpus / "stream" / "finding_grid_empty_section.mpm");
+  std::string message;
+  EXPECT_NO_THROW(message = feed(stream, b));
+  EXPECT_NE(message.find("stream.mpm: "), std::string::npos) << message;
+}
+
 }  // namespace
 }  // namespace mpm::fuzz
