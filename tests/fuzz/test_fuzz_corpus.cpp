@@ -112,6 +112,20 @@ TEST(FuzzFindings, OffFaceWithANegativeCountIsRefusedByLine) {
                          "and list that many vertex indices; found '-1 0 0'"),
             std::string::npos)
       << message;
+  // The same behind a keyword CGAL takes ("OFF~": letters and digits, then any character),
+  // which the first version of the check did not (found again by fuzz_mesh).
+  const std::string tilde =
+      feed(mesh, bytes_of(kCorpus / "mesh" / "finding_off_keyword_tilde.off"));
+  EXPECT_NE(tilde.find("mesh.off' line 8: a face line must start with its number of vertices "
+                       "and list that many vertex indices; found '-1 0 0'"),
+            std::string::npos)
+      << tilde;
+  // A header announcing more vertices than the file can hold: CGAL would allocate for them.
+  EXPECT_NE(feed(mesh, "OFF\n2000000000 1 0\n0 0 0\n")
+                .find("its header announces 2000000000 vertices and 1 faces, which its 25 bytes "
+                      "cannot hold"),
+            std::string::npos)
+      << feed(mesh, "OFF\n2000000000 1 0\n0 0 0\n");
   const std::string off = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 -2\n";
   EXPECT_NE(feed(mesh, off).find("line 6: vertex index 3 of the face is not a vertex number from 0 "
                                  "to 2; found '3 0 1 -2'"),

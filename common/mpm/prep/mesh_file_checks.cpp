@@ -1,8 +1,13 @@
-// Checks of mesh files before CGAL reads them (mesh_file_checks.hpp).
+// Checks of mesh files before CGAL reads them (mesh_file_checks.hpp). The OFF check follows
+// CGAL 5.5's OFF scanner step by step (File_header_OFF's operator>>, File_scanner_OFF's
+// scan_vertex and scan_facet), so that it sees the lines CGAL will see.
 #include "mpm/prep/mesh_file_checks.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -12,17 +17,20 @@ namespace mpm {
 
 namespace {
 
-/// The next line holding data, as CGAL's OFF scanner takes it: blank lines and lines starting
-/// with '#' skipped, the rest of a line after '#' dropped. False at the end of the file.
-bool next_data_line(std::istream& in, std::string& line, int& number) {
-  while (std::getline(in, line)) {
-    ++number;
-    const std::size_t first = line.find_first_not_of(" \t\r\f\v");
-    if (first == std::string::npos || line[first] == '#') continue;
-    if (const std::size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-    return true;
-  }
-  return false;
+/// CGAL's skip_comment_OFF: skips white space and lines starting with '#'.
+void skip_comment(std::istream& in) {
+  char c = 0;
+  while ((in >> c) && c == '#') in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+  if (in) in.putback(c);
+}
+
+/// The next line as CGAL's scanner reads a vertex or a face: comments skipped, the rest of
+/// the line after '#' dropped. False at the end of the file.
+bool next_line(std::istream& in, std::string& line) {
+  skip_comment(in);
+  if (!std::getline(in, line)) return false;
+  if (const std::size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+  return true;
 }
 
 /// Whether v converts to std::size_t with a defined result (and fits OFF's 32-bit indices).
@@ -33,46 +41,67 @@ bool whole_index(double v) {
 }  // namespace
 
 void check_off_faces(const std::string& path, const std::string& at, const std::string& name) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream file(path, std::ios::binary);
+  std::stringstream buffer;
+  buffer << file.rdbuf();
+  const std::string text = buffer.str();
+  std::istringstream in(text);
+  auto line_of = [&]() {
+    const auto pos = in.tellg() < 0 ? std::streamoff(text.size()) : std::streamoff(in.tellg());
+    return 1 + std::count(text.begin(), text.begin() + pos, '\n');
+  };
+  // The header: comments, then the keyword [ST][C][N][4][n]OFF (letters and digits only), then
+  // the counts (vertices, faces, edges; a dimension first for nOFF).
+  char c = 0;
+  while ((in >> c) && c == '#') in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+  if (!in) return;
+  std::string keyword(1, c);
+  while (keyword.size() < 41 && in.get(c) && std::isalnum(static_cast<unsigned char>(c)))
+    keyword += c;
+  std::size_t j = keyword.compare(0, 2, "ST") == 0 ? 2 : 0;
+  for (char prefix : {'C', 'N', '4'})
+    if (j < keyword.size() && keyword[j] == prefix) ++j;
+  const bool dimensional = j < keyword.size() && keyword[j] == 'n';
+  if (keyword.substr(j + (dimensional ? 1 : 0)) != "OFF") return;  // SKEL, or not OFF: CGAL's
+  skip_comment(in);
+  if (!in.get(c) || !std::isdigit(static_cast<unsigned char>(c))) return;  // BINARY
+  in.putback(c);
+  long long vertices = 0, faces = 0;
+  int n = 0;
+  in >> n;
+  vertices = n;
+  if (dimensional && (in >> n)) vertices = n;
+  if (!(in >> n)) return;
+  faces = n;
+  const std::string where = "mesh " + name;
+  // Each vertex and face takes a line: a count beyond the file's size would only make CGAL
+  // allocate for it (a negative one wraps round to 2^64).
+  if (vertices < 0 || faces < 0 || std::size_t(vertices) > text.size() ||
+      std::size_t(faces) > text.size())
+    throw InputError(at, where + ": its header announces " + std::to_string(vertices) +
+                             " vertices and " + std::to_string(faces) + " faces, which its " +
+                             std::to_string(text.size()) + " bytes cannot hold");
+  if (!(in >> n)) return;  // the edge count; the first vertex is the next line CGAL reads
   std::string line;
-  int number = 0;
-  if (!next_data_line(in, line, number)) return;
-  // The header: [ST][C][N][4][n]OFF [BINARY], then (on its line or the next) the counts.
-  std::istringstream head(line);
-  std::string keyword;
-  head >> keyword;
-  if (keyword.size() < 3 || keyword.compare(keyword.size() - 3, 3, "OFF") != 0) return;
-  const bool n_dimensional = keyword.find('n') != std::string::npos;
-  std::string rest;
-  std::getline(head, rest);
-  if (rest.find("BINARY") != std::string::npos || n_dimensional) return;
-  std::istringstream counts(rest);
-  long long vertices = -1, faces = -1;
-  if (!(counts >> vertices >> faces)) {
-    if (!next_data_line(in, line, number)) return;
-    std::istringstream next(line);
-    if (!(next >> vertices >> faces)) return;
-  }
-  if (vertices < 0 || faces < 0) return;  // CGAL refuses the header
   for (long long v = 0; v < vertices; ++v)
-    if (!next_data_line(in, line, number)) return;
+    if (!next_line(in, line)) return;
   for (long long f = 0; f < faces; ++f) {
-    if (!next_data_line(in, line, number)) return;
+    if (!next_line(in, line)) return;
     std::istringstream words(line);
     std::vector<double> entries;
     for (double d; words >> d;) entries.push_back(d);
-    if (entries.empty()) return;  // CGAL stops reading here
-    const std::string where = "mesh " + name + " line " + std::to_string(number) + ": ";
+    if (entries.empty()) return;                                    // CGAL stops reading here
+    const long long number = in.eof() ? line_of() : line_of() - 1;  // the line just read
+    const std::string here = where + " line " + std::to_string(number) + ": ";
     if (!whole_index(entries[0]) || entries[0] > double(entries.size() - 1))
-      throw InputError(at, where +
+      throw InputError(at, here +
                                "a face line must start with its number of vertices and list "
                                "that many vertex indices; found '" +
                                line + "'");
     for (std::size_t k = 1; k <= std::size_t(entries[0]); ++k)
       if (!whole_index(entries[k]))
-        throw InputError(at, where + "vertex index " + std::to_string(k) +
-                                 " of the face is not a vertex number from 0 "
-                                 "to " +
+        throw InputError(at, here + "vertex index " + std::to_string(k) +
+                                 " of the face is not a vertex number from 0 to " +
                                  std::to_string(vertices - 1) + "; found '" + line + "'");
   }
 }
