@@ -133,6 +133,20 @@ TEST(FuzzFindings, OffFaceWithANegativeCountIsRefusedByLine) {
       << feed(mesh, off);
 }
 
+// An STOFF file (texture coordinates on every vertex line) whose vertex lines hold fewer
+// entries: CGAL's scan_texture read past them (ASan: SEGV in File_scanner_OFF.h:214). Only
+// plain OFF is read now; the variants are refused by name.
+TEST(FuzzFindings, OffVariantsAreRefusedByTheirKeyword) {
+  const std::string message =
+      feed(mesh, bytes_of(kCorpus / "mesh" / "finding_stoff_short_vertex.off"));
+  EXPECT_NE(message.find("mesh.off' starts with 'STOFF', not OFF: only plain OFF files are read"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(
+      feed(mesh, "COFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").find("starts with 'COFF', not OFF"),
+      std::string::npos);
+}
+
 // An OBJ cube whose faces were cut into one another by the mutation: the walk around a hole
 // in the message of an open mesh (describe_holes, written in this session) followed next()
 // around a border cycle that never came back to its first edge, for ever (a fuzz_mesh

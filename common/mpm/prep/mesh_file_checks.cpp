@@ -50,19 +50,21 @@ void check_off_faces(const std::string& path, const std::string& at, const std::
     const auto pos = in.tellg() < 0 ? std::streamoff(text.size()) : std::streamoff(in.tellg());
     return 1 + std::count(text.begin(), text.begin() + pos, '\n');
   };
-  // The header: comments, then the keyword [ST][C][N][4][n]OFF (letters and digits only), then
-  // the counts (vertices, faces, edges; a dimension first for nOFF).
+  // The header: comments, then the keyword (letters and digits), then the counts (vertices,
+  // faces, edges).
   char c = 0;
   while ((in >> c) && c == '#') in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
   if (!in) return;
   std::string keyword(1, c);
   while (keyword.size() < 41 && in.get(c) && std::isalnum(static_cast<unsigned char>(c)))
     keyword += c;
-  std::size_t j = keyword.compare(0, 2, "ST") == 0 ? 2 : 0;
-  for (char prefix : {'C', 'N', '4'})
-    if (j < keyword.size() && keyword[j] == prefix) ++j;
-  const bool dimensional = j < keyword.size() && keyword[j] == 'n';
-  if (keyword.substr(j + (dimensional ? 1 : 0)) != "OFF") return;  // SKEL, or not OFF: CGAL's
+  // Only plain OFF: CGAL reads the texture, colour, normal and homogeneous entries of the
+  // variants ([ST][C][N][4][n]OFF) without checking that a line holds them (fuzz_mesh: STOFF
+  // read past a vertex line's entries), and mpm-prep needs none of them.
+  if (keyword != "OFF")
+    throw InputError(at, "mesh " + name + " starts with '" + keyword +
+                             "', not OFF: only plain OFF files are read (no texture, colour, "
+                             "normal or homogeneous variants); save it as plain OFF, STL or OBJ");
   skip_comment(in);
   if (!in.get(c) || !std::isdigit(static_cast<unsigned char>(c))) return;  // BINARY
   in.putback(c);
@@ -70,7 +72,6 @@ void check_off_faces(const std::string& path, const std::string& at, const std::
   int n = 0;
   in >> n;
   vertices = n;
-  if (dimensional && (in >> n)) vertices = n;
   if (!(in >> n)) return;
   faces = n;
   const std::string where = "mesh " + name;

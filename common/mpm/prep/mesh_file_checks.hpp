@@ -7,9 +7,9 @@ namespace mpm {
 
 /// An ASCII OFF file's faces: each face line must start with its vertex count and list that
 /// many vertex indices, all whole numbers from 0 (CGAL converts them from double unchecked:
-/// "-1" or "1e30" is undefined behaviour there). Files it cannot follow (binary OFF, a header
-/// it does not know) are left to CGAL. Throws InputError(at, ...) naming the mesh `name`
-/// and the line.
+/// "-1" or "1e30" is undefined behaviour there), and only plain OFF is read (CGAL reads the
+/// entries of the texture, colour and normal variants unchecked). Binary OFF is left to CGAL.
+/// Throws InputError(at, ...) naming the mesh `name` and the line.
 void check_off_faces(const std::string& path, const std::string& at, const std::string& name);
 
 }  // namespace mpm
