@@ -1,5 +1,6 @@
 // mpm-post: what users report from a result stream.
 //   mpm-post summary run.mpm            mpm-post history run.mpm -o history.csv
+//   mpm-post scene run.mpm > scene.toml
 //   mpm-post vtk run.mpm -o out/        mpm-post taylor run.mpm --json
 //   mpm-post particles run.mpm --columns x,sigma -o last.csv
 //   mpm-post render run.mpm -o bar.png --field eps_p
@@ -19,6 +20,14 @@ CLI::App* add_summary(CLI::App& app, mpm::SummaryArgs& a) {
   auto* sub = app.add_subcommand("summary", "what a stream holds: frames, history, end status");
   sub->add_option("input", a.input, "stream, - for stdin")->capture_default_str();
   sub->add_flag("--json", a.json, "print JSON");
+  return sub;
+}
+
+CLI::App* add_scene(CLI::App& app, mpm::SceneArgs& a) {
+  auto* sub = app.add_subcommand(
+      "scene", "the scene a model or result holds, as TOML (with the --set overrides applied)");
+  sub->add_option("input", a.input, "stream, - for stdin")->capture_default_str();
+  sub->add_option("-o,--output", a.output, "TOML file, - for stdout")->capture_default_str();
   return sub;
 }
 
@@ -224,11 +233,13 @@ int main(int argc, char** argv) {
       "mpm-post: read a result stream (from mpm-run) and report.\n"
       "INPUT is a stream file or - for stdin. --json on measurements prints JSON.\n"
       "Exit status: 0 done, 2 bad input or damaged stream (the frames before the\n"
-      "damage are still used), 3 the run was unstable, 4 write failure.",
+      "damage are still used), 3 the run was unstable, 4 write failure,\n"
+      "5 the run stopped: a particle left the domain.",
       "mpm-post"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("mpm-post ") + mpm::kVersion);
   mpm::SummaryArgs summary_args;
+  mpm::SceneArgs scene_args;
   mpm::HistoryArgs history_args;
   mpm::ParticlesArgs particles_args;
   mpm::VtkArgs vtk_args;
@@ -238,6 +249,7 @@ int main(int argc, char** argv) {
   mpm::CraterArgs crater_args;
   mpm::RenderArgs render_args;
   const auto* summary = add_summary(app, summary_args);
+  const auto* scene = add_scene(app, scene_args);
   const auto* history = add_history(app, history_args);
   const auto* particles = add_particles(app, particles_args);
   const auto* vtk = add_vtk(app, vtk_args);
@@ -255,6 +267,7 @@ int main(int argc, char** argv) {
   return mpm::guarded_main("mpm-post", [&]() -> int {
     mpm::ignore_sigpipe();
     // No subcommand writes over the stream it reads.
+    if (*scene) mpm::check_output_file(scene_args.output, {scene_args.input});
     if (*history) mpm::check_output_file(history_args.output, {history_args.input});
     if (*particles) mpm::check_output_file(particles_args.output, {particles_args.input});
     if (*profile) mpm::check_output_file(profile_args.output, {profile_args.input});
@@ -267,6 +280,7 @@ int main(int argc, char** argv) {
     if (*profile) mpm::require_result(profile_args.input, "profile");
     if (*render) mpm::require_result(render_args.input, "render");
     if (*summary) return mpm::post_summary(summary_args);
+    if (*scene) return mpm::post_scene(scene_args);
     if (*history) return mpm::post_history(history_args);
     if (*particles) return mpm::post_particles(particles_args);
     if (*vtk) return mpm::post_vtk(vtk_args);

@@ -13,7 +13,8 @@ int main(int argc, char** argv) {
       "mpm-run: explicit material point method solver.\n"
       "Reads a model stream (from mpm-prep) and writes a result stream of frames and\n"
       "histories (for mpm-post). Exit status: 0 done, 2 bad input, 3 unstable run,\n"
-      "4 write failure, 128+N stopped by signal N (SIGINT, SIGTERM: after a checkpoint;\n"
+      "4 write failure, 5 a particle left the domain (solver.on_exit = \"stop\"),\n"
+      "128+N stopped by signal N (SIGINT, SIGTERM: after a checkpoint;\n"
       "continue with --restart RESULT).",
       "mpm-run"};
   mpm::RunOptions opt;

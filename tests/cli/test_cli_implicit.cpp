@@ -34,7 +34,8 @@ TEST(CliImplicit, RunsAndWritesItsWorkToTheHistory) {
   // The per-row counts add up to the last row's total.
   std::istringstream lines(r.out);
   std::string line;
-  std::getline(lines, line);
+  do std::getline(lines, line);  // the header, after the comment with the units
+  while (line.rfind('#', 0) == 0);
   double sum = 0, total = 0, rows = 0;
   while (std::getline(lines, line)) {
     std::vector<double> v;
@@ -99,10 +100,12 @@ TEST(CliImplicit, PostParticlesWritesCsv) {
   r = run(post + " particles " + out.string() + " --columns id,x,sigma --frame 0", dir);
   ASSERT_EQ(r.status, 0) << r.err;
   std::istringstream lines(r.out);
-  std::string comment, header, row;
+  std::string comment, units, header, row;
   std::getline(lines, comment);
+  std::getline(lines, units);
   std::getline(lines, header);
   EXPECT_EQ(comment.rfind("# t = 0 s", 0), 0u) << comment;
+  EXPECT_EQ(units, "# units: -,m,m,m,Pa,Pa,Pa,Pa,Pa,Pa");
   EXPECT_EQ(header, "id,x_0,x_1,x_2,sigma_0,sigma_1,sigma_2,sigma_3,sigma_4,sigma_5");
   long n = 0;
   while (std::getline(lines, row)) ++n;

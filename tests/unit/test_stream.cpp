@@ -279,7 +279,7 @@ TEST(Stream, HeaderBytes) {
     EXPECT_EQ(w.bytes_written(), 16u);
   }
   const Bytes b = slurp(p);
-  EXPECT_EQ(b, Bytes("\x89MPM\r\n\x1a\n\x01\x00\x03\x00\x00\x00\x00\x00", 16));  // 1.3
+  EXPECT_EQ(b, Bytes("\x89MPM\r\n\x1a\n\x01\x00\x04\x00\x00\x00\x00\x00", 16));  // 1.4
   // A stream with no records reads cleanly, but has not ended.
   Collected c;
   const StreamSummary s = read_stream(p, c.visitor());

@@ -859,7 +859,7 @@ TEST(Voxelise, BodyOutsideTheDomainOrTooThinIsRefused) {
   EXPECT_NE(msg.find("bodies.nomat.material"), std::string::npos) << msg;
 }
 
-TEST(Voxelise, RefusesBadShapesAndTooManyBodies) {
+TEST(Voxelise, RefusesBadShapesAndOverlappingBodies) {
   Scene s = make_scene(3, 0.1, Vec3::Zero(), Vec3::Ones());
   s.bodies = {box("flat", Vec3(0.2, 0, 0.2), Vec3(0.5, 0.5, 0.5))};
   EXPECT_NE(input_error_of([&] { run(s); }).find("scene.toml:10: bodies.flat.size"),
@@ -880,15 +880,17 @@ TEST(Voxelise, RefusesBadShapesAndTooManyBodies) {
   EXPECT_NE(input_error_of([&] { run(s); }).find("bodies.coarse.particles_per_cell"),
             std::string::npos);
 
-  // Body ids are 8-bit: 255 bodies at most.
+  // No limit of 255 bodies any more (ids are 32-bit past 255, tests/cli/test_many_bodies.cpp):
+  // 256 spheres in one place are refused for their overlap, not their number.
   s.bodies.clear();
   for (int i = 0; i < 256; ++i) {
     char name[8];  // (not "b" + std::to_string(i): GCC 12 warns falsely with -Wrestrict)
     std::snprintf(name, sizeof name, "b%d", i);
-    s.bodies.push_back(sphere(name, 0.01, Vec3::Ones() * 0.5));
+    s.bodies.push_back(sphere(name, 0.2, Vec3::Ones() * 0.5));
   }
   const std::string msg = input_error_of([&] { run(s); });
-  EXPECT_NE(msg.find("256 bodies; a model holds at most 255"), std::string::npos) << msg;
+  EXPECT_EQ(msg.find("at most 255"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("body 'b1' has no particles: all its"), std::string::npos) << msg;
 }
 
 TEST(Voxelise, OutputDoesNotDependOnTheThreadCount) {

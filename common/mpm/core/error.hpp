@@ -8,10 +8,11 @@ namespace mpm {
 /// Exit statuses of mpm-prep, mpm-run and mpm-post (documented in docs/format.md).
 enum ExitStatus : int {
   kExitOk = 0,
-  kExitInternal = 1,  ///< a bug or an unexpected system failure
-  kExitBadInput = 2,  ///< the user's input (scene, option, mesh, stream) is wrong
-  kExitUnstable = 3,  ///< the run went unstable; frames written so far stay valid
-  kExitIo = 4,        ///< writing failed (disk full, closed pipe)
+  kExitInternal = 1,    ///< a bug or an unexpected system failure
+  kExitBadInput = 2,    ///< the user's input (scene, option, mesh, stream) is wrong
+  kExitUnstable = 3,    ///< the run went unstable; frames written so far stay valid
+  kExitIo = 4,          ///< writing failed (disk full, closed pipe)
+  kExitLeftDomain = 5,  ///< a particle left the domain with solver.on_exit = "stop"; frames valid
 };
 
 /// A mistake in the user's input. what() reads "where: message", where names the file, the

@@ -28,6 +28,14 @@ struct HistoryArgs {
 };
 int post_history(const HistoryArgs& args);
 
+/// mpm-post scene: the scene a model or result stream holds (TOML, after --set overrides), so
+/// that `mpm-post scene RESULT > scene.toml` gives back a scene mpm-prep reads.
+struct SceneArgs {
+  std::string input = "-";   ///< stream ("-": stdin)
+  std::string output = "-";  ///< TOML file ("-": stdout)
+};
+int post_scene(const SceneArgs& args);
+
 /// mpm-post particles: the particles of one frame as CSV, a column per component (x_0, x_1,
 /// sigma_0 ... sigma_5).
 struct ParticlesArgs {

@@ -11,6 +11,7 @@
 #include "mpm/post/command_io.hpp"
 #include "mpm/post/commands.hpp"
 #include "mpm/post/json.hpp"
+#include "mpm/scene/particles.hpp"
 
 namespace mpm {
 
@@ -216,25 +217,37 @@ std::vector<const Column*> particle_columns(const Frame& frame,
   return picked;
 }
 
-/// The CSV of particles: a comment with the time and step, a header, a row per particle.
+/// The CSV of particles: comments with the time and step and the columns' units, a header, a
+/// row per particle. With `body_names` (from the stream's scene) and the body column picked, a
+/// last column body_name names each particle's body.
 void write_particles_csv(std::FILE* f, const std::string& path, const Frame& frame,
-                         const std::vector<const Column*>& picked) {
+                         const std::vector<const Column*>& picked,
+                         const std::vector<std::string>& body_names) {
   std::fprintf(f, "# t = %.10g s, step %lld\n", frame.time, (long long)frame.step);
-  bool first = true;
+  const Column* body = nullptr;
+  for (const Column* c : picked)
+    if (c->info().name == col::body && !body_names.empty()) body = c;
+  std::string header, units;
   for (const Column* c : picked)
     for (int k = 0; k < c->info().components; ++k) {
-      std::fprintf(f, "%s%s", first ? "" : ",", c->info().name.c_str());
-      if (c->info().components > 1) std::fprintf(f, "_%d", k);
-      first = false;
+      if (!header.empty()) header += ',', units += ',';
+      header += c->info().name;
+      if (c->info().components > 1) header += "_" + std::to_string(k);
+      units += c->info().unit.empty() ? "-" : c->info().unit;
     }
-  std::fprintf(f, "\n");
+  if (body) header += ",body_name", units += ",-";
+  std::fprintf(f, "# units: %s\n%s\n", units.c_str(), header.c_str());
   for (std::size_t i = 0; i < frame.columns.size(); ++i) {
-    first = true;
+    bool first = true;
     for (const Column* c : picked)
       for (int k = 0; k < c->info().components; ++k) {
         std::fprintf(f, "%s%.10g", first ? "" : ",", column_value(*c, i, k));
         first = false;
       }
+    if (body) {
+      const auto b = std::size_t(column_value(*body, i, 0));
+      std::fprintf(f, ",%s", b < body_names.size() ? body_names[b].c_str() : "?");
+    }
     std::fprintf(f, "\n");
     check_written(f, path);
   }
@@ -288,6 +301,10 @@ int post_history(const HistoryArgs& a) {
     if (names.empty()) {
       names = h.names;
       pick = history_columns(names, a.columns);
+      std::fprintf(f, "# units:");
+      for (std::size_t k = 0; k < pick.size(); ++k)
+        std::fprintf(f, "%s%s", k ? "," : " ", h.units[pick[k]].c_str());
+      std::fprintf(f, "\n");
       for (std::size_t k = 0; k < pick.size(); ++k)
         std::fprintf(f, "%s%s", k ? "," : "", names[pick[k]].c_str());
       std::fprintf(f, "\n");
@@ -313,7 +330,9 @@ int post_particles(const ParticlesArgs& a) {
   const long want = option_frame(a.frame);
   std::optional<Frame> chosen;
   long index = 0;
+  std::string scene_text;
   StreamVisitor v;
+  v.scene = [&](const std::string& t) { scene_text = t; };
   v.frame = [&](Frame&& f) {
     if (want < 0 || index == want) chosen = std::move(f);
     ++index;
@@ -326,9 +345,37 @@ int post_particles(const ParticlesArgs& a) {
   }
   const std::vector<const Column*> picked = particle_columns(*chosen, a.columns);
   std::FILE* f = open_output(a.output);
-  write_particles_csv(f, a.output, *chosen, picked);
+  std::vector<std::string> body_names;
+  if (!scene_text.empty())
+    for (const BodySpec& b : scene_of(scene_text, a.input).bodies) body_names.push_back(b.name);
+  write_particles_csv(f, a.output, *chosen, picked, body_names);
   close_output(f, a.output);
   return conclude(a.input, s, std::size_t(index));
+}
+
+int post_scene(const SceneArgs& a) {
+  std::string scene_text;
+  bool seen = false;
+  std::size_t frames = 0;
+  StreamVisitor v;
+  v.want_frames = false;
+  v.scene = [&](const std::string& t) {
+    if (!seen) scene_text = t;
+    seen = true;
+  };
+  v.frame = [&](Frame&&) { ++frames; };
+  const StreamSummary s = read_stream(a.input, v);
+  if (!seen) {
+    std::fprintf(stderr, "mpm-post: error: %s holds no scene record\n",
+                 input_name(a.input).c_str());
+    return kExitBadInput;
+  }
+  std::FILE* f = open_output(a.output);
+  std::fprintf(f, "%s", scene_text.c_str());
+  if (!scene_text.empty() && scene_text.back() != '\n') std::fprintf(f, "\n");
+  check_written(f, a.output);
+  close_output(f, a.output);
+  return conclude(a.input, s, frames);
 }
 
 }  // namespace mpm

@@ -161,9 +161,9 @@ void apply_initial_fields(const Scene& scene, ColumnStore& cols) {
   if (stress && !cols.has(col::sigma)) cols.add({col::sigma, ScalarType::F64, 6, "Pa"});
   // The particles of each body with fields, in one pass over the particles.
   std::vector<std::vector<std::size_t>> of_body(scene.bodies.size());
-  const Column& body = cols.at(col::body);
+  const BodyIds body(cols.find(col::body));
   for (std::size_t i = 0; i < cols.size(); ++i) {
-    const std::size_t b = body_id(body, i);
+    const std::size_t b = std::size_t(body[i]);
     if (scene.bodies[b].has_initial_fields()) of_body[b].push_back(i);
   }
   for (std::size_t b = 0; b < scene.bodies.size(); ++b) {

@@ -174,9 +174,12 @@ std::size_t print_bodies(const Scene& scene, const std::vector<BodyReport>& repo
   std::fprintf(stderr, "  %-14s %-12s %12s %10s %14s %14s %8s\n", "body", "material", "particles",
                "spacing", "mass kg", "exact kg", "error");
   std::size_t total = 0;
+  const std::size_t shown = report.size() > 24 ? 12 : report.size();  // a table of grains: its head
   for (std::size_t b = 0; b < report.size(); ++b) {
     const BodyReport& r = report[b];
     total += r.particles;
+    if (b == shown) std::fprintf(stderr, "  ... %zu bodies more\n", report.size() - shown);
+    if (b >= shown) continue;
     std::fprintf(
         stderr, "  %-14s %-12s %12zu %7s mm %14.6g %14.6g %7.2f%%\n", r.name.c_str(),
         scene.bodies[b].rigid ? "(rigid)" : scene.materials[scene.bodies[b].material].name.c_str(),

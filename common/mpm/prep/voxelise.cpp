@@ -58,14 +58,10 @@ double density_of(const Scene& scene, const BodySpec& body) {
   return body.rigid ? 1.0 : scene.materials[body.material].density;
 }
 
-/// At least one body and at most 255 (body ids are 8-bit).
+/// At least one body.
 void check_body_count(const Scene& scene) {
-  const std::size_t nb = scene.bodies.size();
-  if (nb == 0) throw InputError(where(scene.source, 0, "bodies"), "the scene has no bodies");
-  if (nb > 255)
-    throw InputError(where(scene.source, scene.bodies[255].loc.line, "bodies"),
-                     "the scene has " + std::to_string(nb) +
-                         " bodies; a model holds at most 255 (body ids are 8-bit)");
+  if (scene.bodies.empty())
+    throw InputError(where(scene.source, 0, "bodies"), "the scene has no bodies");
 }
 
 /// What a body needs besides its shape (make_region checks that): a valid material with a
@@ -349,7 +345,8 @@ void count_body(BodyPlan& P, std::size_t b, const Lattice& lat, const VoxeliseCe
 /// The model's columns (voxelise.hpp), as pointers into the store.
 struct ModelColumns {
   std::uint32_t* id;
-  std::uint8_t* body;
+  std::uint8_t* body8;    // up to 255 bodies (body_column)
+  std::uint32_t* body32;  // more
   std::uint8_t* material;
   double* x;
   double* v;
@@ -358,10 +355,10 @@ struct ModelColumns {
 };
 
 /// The store of `total` particles with the model's columns.
-ColumnStore model_store(int dim, std::size_t total) {
+ColumnStore model_store(int dim, std::size_t total, std::size_t bodies) {
   ColumnStore store;
   store.add({"id", ScalarType::U32, 1, "-"});
-  store.add({"body", ScalarType::U8, 1, "-"});
+  store.add(body_column(bodies));
   store.add({"material", ScalarType::U8, 1, "-"});
   store.add({"x", ScalarType::F64, dim, "m"});
   store.add({"v", ScalarType::F64, dim, "m/s"});
@@ -372,8 +369,10 @@ ColumnStore model_store(int dim, std::size_t total) {
 }
 
 ModelColumns model_columns(ColumnStore& store) {
+  const bool narrow = store.at("body").info().type == ScalarType::U8;
   return {store.get<std::uint32_t>("id"),
-          store.get<std::uint8_t>("body"),
+          narrow ? store.get<std::uint8_t>("body") : nullptr,
+          narrow ? nullptr : store.get<std::uint32_t>("body"),
           store.get<std::uint8_t>("material"),
           reinterpret_cast<double*>(store.at("x").data()),
           reinterpret_cast<double*>(store.at("v").data()),
@@ -387,7 +386,6 @@ void write_body(const BodyPlan& P, const Scene& scene, std::size_t b, int dim, s
                 const ModelColumns& col) {
   const BodySpec& body = scene.bodies[b];
   const double density = density_of(scene, body);
-  const auto body_id = static_cast<std::uint8_t>(b);
   const auto mat_id = static_cast<std::uint8_t>(body.rigid ? kRigidMaterial : body.material);
   const bool axi = scene.axisymmetric;
 #pragma omp parallel for schedule(dynamic, 8)
@@ -418,7 +416,10 @@ void write_body(const BodyPlan& P, const Scene& scene, std::size_t b, int dim, s
           v[2] = body.velocity.z();
         }
         col.id[k] = static_cast<std::uint32_t>(k);
-        col.body[k] = body_id;
+        if (col.body8)
+          col.body8[k] = static_cast<std::uint8_t>(b);
+        else
+          col.body32[k] = static_cast<std::uint32_t>(b);
         col.material[k] = mat_id;
         col.mass[k] = axi ? P.mass * x[0] : P.mass;  // axisymmetric: per radian, A r
         col.rho[k] = density;
@@ -475,7 +476,7 @@ ColumnStore voxelise(const Scene& scene, const Lattice& lat, std::vector<BodyRep
   }
 
   // Pass 2: fill the columns, every body's rows at their prefix-sum offsets.
-  ColumnStore store = model_store(dim, total);
+  ColumnStore store = model_store(dim, total, nb);
   const ModelColumns col = model_columns(store);
   std::size_t base = 0;
   for (std::size_t b = 0; b < nb; ++b) {

@@ -16,6 +16,8 @@
 #include "mpm/core/units.hpp"
 #include "mpm/core/version.hpp"
 #include "mpm/grid/lattice.hpp"
+#include "mpm/run/extremes.hpp"
+#include "mpm/run/history.hpp"
 #include "mpm/run/restart.hpp"
 #include "mpm/scene/particles.hpp"
 #include "mpm/solver/explicit/explicit_solver.hpp"
@@ -141,113 +143,6 @@ Model read_model(const RunOptions& opt) {
   return model;
 }
 
-/// True for a solver with the implicit one's work counters.
-template <class Solver>
-concept HasImplicitWork = requires(const Solver& s) {
-  s.work();
-  s.explicit_dt();
-};
-
-/// History rows, written as HIST records at each frame and every few thousand rows.
-class History {
- public:
-  History(int dim, const Scene& scene, bool implicit)
-      : dim_(dim), factor_(scene.measure_factor()), implicit_(implicit) {
-    const BoundarySpec& bc = scene.boundary;
-    add("step", "-");
-    add("time", "s");
-    add("dt", "s");
-    add("kinetic", "J");
-    add("internal", "J");
-    add("external_work", "J");
-    add("removed", "J");
-    add("total", "J");
-    add("leapfrog_total", "J");
-    const char* axes[3] = {"momentum_x", "momentum_y", "momentum_z"};
-    for (int a = 0; a < dim; ++a) add(axes[a], "kg m/s");
-    add("particles", "-");
-    if (scene.solver.on_exit == OnExit::Remove) {  // what left, so that the totals close
-      removed_ = true;
-      add("removed_mass", "kg");
-      const char* out[3] = {"removed_momentum_x", "removed_momentum_y", "removed_momentum_z"};
-      for (int a = 0; a < dim; ++a) add(out[a], "kg m/s");
-    }
-    for (int f = 0; f < 2 * dim; ++f)
-      if (bc.face[f] != BoundaryType::Free) {
-        faces_.push_back(f);
-        add(std::string("force_") + face_name(f), "N");
-      }
-    for (std::size_t b = 0; b < scene.bodies.size(); ++b)
-      if (scene.bodies[b].rigid) {
-        rigid_.push_back(int(b));
-        for (int a = 0; a < dim; ++a) add("force_" + scene.bodies[b].name + "_" + "xyz"[a], "N");
-      }
-    if (implicit_) {
-      // Work of the implicit solver since the previous row, then totals since t = 0.
-      add("dt_multiple", "-");
-      add("newton", "-");
-      add("krylov", "-");
-      add("residual_evals", "-");
-      add("line_search_cuts", "-");
-      add("step_cuts", "-");
-      add("newton_total", "-");
-      add("krylov_total", "-");
-      add("residual_evals_total", "-");
-    }
-  }
-  template <class Solver>
-  void record(const Solver& s, double dt) {
-    if (s.steps() == last_step_) return;  // one row per time
-    last_step_ = s.steps();
-    const Balance& b = s.balance();
-    // Extensive values as totals: per metre in plane strain, the whole ring in axisymmetry.
-    const double k = factor_;
-    std::vector<double> row = {double(s.steps()), s.time(),       dt,
-                               k * b.kinetic,     k * b.internal, k * b.external_work,
-                               k * b.removed,     k * b.total(),  k * b.leapfrog_total};
-    for (int a = 0; a < dim_; ++a) row.push_back(k * b.momentum[a]);
-    row.push_back(double(const_cast<Solver&>(s).particles().size()));
-    if (removed_) {
-      row.push_back(k * b.removed_mass);
-      for (int a = 0; a < dim_; ++a) row.push_back(k * b.removed_momentum[a]);
-    }
-    for (int f : faces_) row.push_back(factor_ * s.face_force()[f]);
-    for (int b : rigid_)
-      for (int a = 0; a < dim_; ++a) row.push_back(factor_ * s.rigid_force()[b][a]);
-    if constexpr (HasImplicitWork<Solver>) {
-      const ImplicitWork& w = s.work();
-      row.insert(row.end(),
-                 {dt / s.explicit_dt(), double(w.newton - last_.newton),
-                  double(w.krylov - last_.krylov), double(w.evaluations - last_.evaluations),
-                  double(w.line_search_cuts - last_.line_search_cuts),
-                  double(w.step_cuts - last_.step_cuts), double(w.newton), double(w.krylov),
-                  double(w.evaluations)});
-      last_ = w;
-    }
-    block_.values.insert(block_.values.end(), row.begin(), row.end());
-  }
-  void flush(StreamWriter& w) {
-    if (block_.rows() == 0) return;
-    w.write_history(block_);
-    block_.values.clear();
-  }
-  std::size_t pending() const { return block_.rows(); }
-
- private:
-  void add(const std::string& name, const std::string& unit) {
-    block_.names.push_back(name);
-    block_.units.push_back(unit);
-  }
-  int dim_;
-  double factor_;
-  bool implicit_;
-  ImplicitWork last_;     ///< totals at the previous row
-  long last_step_ = -1;   ///< step of the last row
-  bool removed_ = false;  ///< columns of what left the domain (solver.on_exit = "remove")
-  std::vector<int> faces_, rigid_;
-  HistoryBlock block_;
-};
-
 std::string run_info(const Scene& scene, const Lattice& lat, int threads) {
   std::ostringstream o;
   o << "tool = \"mpm-run\"\nversion = \"" << kVersion << "\"\nthreads = " << threads
@@ -356,6 +251,7 @@ class TimeLoop {
         solver_(solver),
         restart_(restart),
         history_(Solver::D, scene, kImplicit),
+        extremes_(scene),
         checkpoint_(scene.output, solver.time()),
         t_output_(solver.timers().id("output")) {
     if (restart) {
@@ -407,6 +303,7 @@ class TimeLoop {
     write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
     emit_grid();
     write_particles(flags, [&](const Frame& f) { out_->write_frame(f, o_.fields, o_.precision); });
+    extremes_.sample(solver_.particles(), solver_.time());
   }
   /// A CHKP record: the particles in cell order (settle) with the state the columns do not
   /// hold; the history rows before it are flushed first, so the stream up to it is complete.
@@ -454,6 +351,7 @@ class TimeLoop {
   const Restart* restart_;
   std::unique_ptr<StreamWriter> out_;
   History history_;
+  MaterialExtremes extremes_;  ///< sampled at each frame, reported at the end
   CheckpointClock checkpoint_;
   int t_output_;
   long grid_revision_ = -1;
@@ -522,7 +420,7 @@ int TimeLoop<Solver>::operator()() {
                  " steps to t = " + std::to_string(solver_.time()) + " s";
   } catch (const InstabilityError& e) {
     progress.done(solver_.time(), solver_.steps());
-    status_ = kExitUnstable;
+    status_ = e.left_domain ? kExitLeftDomain : kExitUnstable;
     message_ = e.what();
   }
   const double loop_wall = omp_get_wtime() - loop_start;  // the time loop, output included
@@ -536,7 +434,7 @@ int TimeLoop<Solver>::operator()() {
 
 template <class Solver>
 void TimeLoop<Solver>::report(double loop_wall) const {
-  if (status_ == kExitUnstable) {
+  if (status_ == kExitUnstable || status_ == kExitLeftDomain) {
     std::fprintf(stderr,
                  "mpm-run: error: %s\nmpm-run: the %d frame(s) written before stay valid "
                  "(last at t = %g s)\n",
@@ -544,6 +442,7 @@ void TimeLoop<Solver>::report(double loop_wall) const {
   } else {
     std::fprintf(stderr, "mpm-run: %s\n", message_.c_str());
   }
+  extremes_.report(stderr);
   if (solver_.removed_particles() > 0)
     std::fprintf(stderr, "mpm-run: %zu particles left the domain and were removed\n",
                  solver_.removed_particles());

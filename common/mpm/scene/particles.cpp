@@ -35,6 +35,22 @@ void ensure(ColumnStore& cols, const ColumnInfo& info) {
 }
 }  // namespace
 
+BodyIds::BodyIds(const Column* c) {
+  if (!c) return;
+  if (c->info().components == 1 && c->info().type == ScalarType::U8)
+    u8_ = c->as<std::uint8_t>();
+  else if (c->info().components == 1 && c->info().type == ScalarType::U32)
+    u32_ = c->as<std::uint32_t>();
+  else
+    throw InputError("model", "particle column 'body' holds " +
+                                  std::to_string(c->info().components) + " x " +
+                                  scalar_name(c->info().type) + ", expected 1 x u8 or 1 x u32");
+}
+
+ColumnInfo body_column(std::size_t bodies) {
+  return {col::body, bodies > 255 ? ScalarType::U32 : ScalarType::U8, 1, "-"};
+}
+
 void prepare_columns(ColumnStore& cols, const Scene& scene) {
   const int d = scene.dimension;
   require(cols, col::x, ScalarType::F64, d);
@@ -43,11 +59,11 @@ void prepare_columns(ColumnStore& cols, const Scene& scene) {
   require(cols, col::rho, ScalarType::F64, 1);
   require(cols, col::id, ScalarType::U32, 1);
   require(cols, col::material, ScalarType::U8, 1);
-  require(cols, col::body, ScalarType::U8, 1);
   const auto* mat = cols.get<std::uint8_t>(col::material);
-  const auto* body = cols.get<std::uint8_t>(col::body);
+  const BodyIds body(cols.find(col::body));
+  if (!body) throw InputError("model", "particle column 'body' is missing");
   for (std::size_t i = 0; i < cols.size(); ++i) {
-    if (body[i] >= scene.bodies.size())
+    if (std::size_t(body[i]) >= scene.bodies.size())
       throw InputError("model", "particle " + std::to_string(i) + " refers to body " +
                                     std::to_string(body[i]) + " but the scene has " +
                                     std::to_string(scene.bodies.size()));
@@ -125,7 +141,7 @@ ParticleView<D> view(ColumnStore& cols) {
   p.thickness = cols.get<double>(col::thickness);
   p.id = cols.get<std::uint32_t>(col::id);
   p.material = cols.get<std::uint8_t>(col::material);
-  p.body = cols.get<std::uint8_t>(col::body);
+  p.body = BodyIds(cols.find(col::body));
   return p;
 }
 template ParticleView<2> view<2>(ColumnStore&);

@@ -15,7 +15,7 @@ namespace mpm {
 /// Column names used by the tools (also the field names in frames and VTK files).
 namespace col {
 inline const std::string id = "id";              ///< u32, stable particle number
-inline const std::string body = "body";          ///< u8, index into Scene::bodies
+inline const std::string body = "body";          ///< u8 (u32 past 255 bodies), Scene::bodies
 inline const std::string material = "material";  ///< u8, index into Scene::materials
 inline const std::string x = "x";                ///< D x f64, position, m
 inline const std::string v = "v";                ///< D x f64, velocity, m/s
@@ -37,11 +37,24 @@ inline const std::string thickness =
 /// Material id of the particles of rigid bodies (they have no material).
 inline constexpr std::uint8_t kRigidMaterial = 255;
 
-/// The body of element i of a body column: u8, or u32 in models of more than 255 bodies.
-inline std::uint32_t body_id(const Column& body, std::size_t i) {
-  return body.info().type == ScalarType::U8 ? std::uint32_t(body.as<std::uint8_t>()[i])
-                                            : body.as<std::uint32_t>()[i];
-}
+/// Read access to a body column of either width: u8, or u32 in models of more than 255
+/// bodies (stream format 1.4). Empty when there is no column.
+class BodyIds {
+ public:
+  BodyIds() = default;
+  /// The ids of column `c` (nullptr: none); throws InputError when it is neither u8 nor u32.
+  explicit BodyIds(const Column* c);
+  /// The body of element i.
+  int operator[](std::size_t i) const { return u8_ ? int(u8_[i]) : int(u32_[i]); }
+  explicit operator bool() const { return u8_ || u32_; }
+
+ private:
+  const std::uint8_t* u8_ = nullptr;
+  const std::uint32_t* u32_ = nullptr;
+};
+
+/// The body column a model of `bodies` bodies stores: u8 up to 255 bodies, else u32.
+ColumnInfo body_column(std::size_t bodies);
 
 /// Raw pointers into the particle columns for the kernels; optional columns are nullptr when
 /// absent. Valid until the columns are resized or reordered.
@@ -62,7 +75,7 @@ struct ParticleView {
   double* thickness = nullptr;  ///< thickness / initial thickness (plane stress)
   std::uint32_t* id = nullptr;
   std::uint8_t* material = nullptr;
-  std::uint8_t* body = nullptr;
+  BodyIds body;
 };
 
 /// Which optional columns a scene's materials need.

@@ -125,6 +125,7 @@ void read_output(Reader& r, Scene& s) {
   o.precision = r.choice<Precision>("precision", {{"float64", Precision::Float64},
                                                   {"float32", Precision::Float32}})
                     .value_or(Precision::Float64);
+  o.body_history = r.boolean("body_history");
   if (r.get("checkpoint")) {
     auto t = r.table("checkpoint", {"time", "wall"});
     o.checkpoint_time = t->quantity("time", dim::time, Bound::Positive).value_or(0.0);

@@ -88,8 +88,8 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
         "end_time is required");
     read_solver(v, s);
   }
-  if (auto o = top.table("output",
-                         {"frames", "history_interval", "fields", "precision", "checkpoint"})) {
+  if (auto o = top.table("output", {"frames", "history_interval", "fields", "precision",
+                                    "checkpoint", "body_history"})) {
     read_output(*o, s);
   }
   if (s.axisymmetric) check_axisymmetric(s);

@@ -3,6 +3,7 @@
 /// is parsed into an enum or a typed SI value here, once; nothing past the parser sees text.
 #include <array>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -261,6 +262,10 @@ struct OutputSpec {
   Precision precision = Precision::Float64;
   double checkpoint_time = 0;  ///< s of simulated time between checkpoints; 0: none
   double checkpoint_wall = 0;  ///< s of wall-clock time between checkpoints; 0: none
+  /// Per-body mass, momentum and energies in the history; unset: when the scene has 2 to
+  /// kBodyHistoryAuto deformable bodies.
+  std::optional<bool> body_history;
+  static constexpr int kBodyHistoryAuto = 16;
 };
 
 struct Scene {

@@ -32,11 +32,15 @@ namespace mpm {
 /// A run that went unstable: the step, the particle (its id) and the cause.
 class InstabilityError : public std::runtime_error {
  public:
-  InstabilityError(long step, double time, long particle, const std::string& cause);
+  /// left_domain: the run stopped because a particle left the domain (solver.on_exit =
+  /// "stop"), which is not an instability: the message says "stopped", the exit status is 5.
+  InstabilityError(long step, double time, long particle, const std::string& cause,
+                   bool left_domain = false);
   long step;
   double time;
   long particle;  ///< particle id, -1 when the cause is global (energy growth)
   std::string cause;
+  bool left_domain;
 };
 
 /// Prescribed velocities of the scene's rigid bodies, by body (zero for deformable bodies);
@@ -62,6 +66,24 @@ std::vector<std::uint8_t> rigid_body_held(const Scene& scene) {
   for (std::size_t b = 0; b < scene.bodies.size(); ++b)
     if (scene.bodies[b].rigid) held[b] = std::uint8_t(all & ~scene.bodies[b].slip_axes);
   return held;
+}
+
+/// The marks rigid bodies leave on the nodes they touch (the grid's u8 column `rigid`): by
+/// body, 1 + its rank among the rigid bodies (0 for deformable bodies); `marked` lists the
+/// rigid bodies by mark - 1. Throws InputError past 255 rigid bodies.
+inline void rigid_body_marks(const Scene& scene, std::vector<std::uint8_t>& mark,
+                             std::vector<std::uint32_t>& marked) {
+  mark.assign(scene.bodies.size(), 0);
+  marked.clear();
+  for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+    if (!scene.bodies[b].rigid) continue;
+    if (marked.size() == 255)
+      throw InputError(
+          where(scene.source, scene.bodies[b].loc.line, "bodies." + scene.bodies[b].name),
+          "a scene holds at most 255 rigid bodies");
+    marked.push_back(std::uint32_t(b));
+    mark[b] = std::uint8_t(marked.size());
+  }
 }
 
 /// Checks that every particle starts inside the grid's domain (InputError naming the first
@@ -199,6 +221,8 @@ class SolverCore {
   std::vector<Vec<D>> rigid_velocity_;    ///< by body; zero for deformable bodies
   std::vector<std::uint8_t> rigid_held_;  ///< by body: the components it imposes (bits)
   std::vector<Vec3> rigid_force_;
+  std::vector<std::uint8_t> rigid_mark_;    ///< by body: its mark on the nodes (rigid_body_marks)
+  std::vector<std::uint32_t> marked_body_;  ///< by mark - 1: the rigid body
   Vec<D> gravity_ = Vec<D>::Zero();
   double dt_ = 0, time_ = 0;  ///< s: the step being taken, the time reached
   long steps_ = 0;
@@ -233,6 +257,7 @@ SolverCore<GridT>::SolverCore(const Scene& scene, GridT grid, ColumnStore& parti
   for (int a = 0; a < D; ++a) gravity_[a] = scene_.solver.gravity[a];
   has_rigid_ = rigid_body_velocities<D>(scene_, rigid_velocity_);
   rigid_held_ = rigid_body_held<D>(scene_);
+  rigid_body_marks(scene_, rigid_mark_, marked_body_);
   rigid_force_.assign(scene_.bodies.size(), Vec3::Zero());
   scratch_.resize(omp_get_max_threads());
   for (auto& s : scratch_) s = std::make_unique<StressScratch>();
@@ -355,7 +380,8 @@ void SolverCore<GridT>::reduce(const std::vector<ChunkSums>& chunks, ChunkSums& 
     total.out_of_window = total.out_of_window || s.out_of_window;
     for (auto i : s.exits) {
       if (scene_.solver.on_exit == OnExit::Stop)
-        throw InstabilityError(steps_ + 1, time_ + dt_, p.id[i], exit_message(p.x[i].data(), D));
+        throw InstabilityError(steps_ + 1, time_ + dt_, p.id[i], exit_message(p.x[i].data(), D),
+                               true);
       exits_.push_back(i);
     }
   }

@@ -17,8 +17,9 @@
 namespace mpm {
 
 inline constexpr std::uint16_t kStreamVersionMajor = 1;  ///< readers refuse other majors
-/// Readers accept any minor (1: GRID; 2: CHKP; 3: ESCP).
-inline constexpr std::uint16_t kStreamVersionMinor = 3;
+/// Readers accept any minor (1: GRID; 2: CHKP; 3: ESCP; 4: the body column u32 in models of
+/// more than 255 bodies).
+inline constexpr std::uint16_t kStreamVersionMinor = 4;
 
 /// Record types (little-endian fourcc).
 enum class RecordType : std::uint32_t {

@@ -132,8 +132,9 @@ class ExplicitSolver : public SolverCore<GridT> {
   using Core::axisymmetric_, Core::balance_, Core::binning_, Core::dt_, Core::exits_,
       Core::face_force_, Core::gravity_, Core::grid_, Core::has_rigid_, Core::material_,
       Core::materials_, Core::need_sort_, Core::node_mass_floor_, Core::particles_,
-      Core::plane_stress_, Core::rigid_force_, Core::rigid_held_, Core::rigid_velocity_,
-      Core::scene_, Core::scratch_, Core::steps_, Core::time_, Core::timers_;
+      Core::plane_stress_, Core::rigid_force_, Core::rigid_held_, Core::rigid_mark_,
+      Core::marked_body_, Core::rigid_velocity_, Core::scene_, Core::scratch_, Core::steps_,
+      Core::time_, Core::timers_;
   using Core::book_rigid_force, Core::reduce, Core::rigid, Core::sort_particles, Core::track_move,
       Core::update_block;
 

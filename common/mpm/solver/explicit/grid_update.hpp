@@ -87,12 +87,13 @@ void ExplicitSolver<GridT>::apply_boundary(std::vector<Vec<D>>& vel, std::vector
   for (std::int64_t i = 0; i < n; ++i) {
     const int mark = grid_.rigid[i];
     if (mark == 0 || grid_.m[i] <= node_mass_floor_) continue;
-    const Vec<D>& vb = rigid_velocity_[mark - 1];
-    const std::uint8_t held = rigid_held_[mark - 1];  // the other components slip
+    const std::uint32_t body = marked_body_[mark - 1];
+    const Vec<D>& vb = rigid_velocity_[body];
+    const std::uint8_t held = rigid_held_[body];  // the other components slip
     for (int a = 0; a < D; ++a) {
       if (!(held >> a & 1)) continue;
       if (record_force)  // what the body pushes back; its work on the material
-        book_rigid_force(mark - 1, a, grid_.m[i] * (vel[i][a] - vb[a]) / dt_);
+        book_rigid_force(int(body), a, grid_.m[i] * (vel[i][a] - vb[a]) / dt_);
       if (acc) (*acc)[i][a] += (vb[a] - vel[i][a]) / dt_;
       vel[i][a] = vb[a];
     }

@@ -119,7 +119,7 @@ void ExplicitSolver<GridT>::mark_rigid_nodes() {
     grid_.values(key, xi, N);
     const int nn = grid_.cell_nodes(key, nodes);
     for (int c = 0; c < nn; ++c)
-      if (N[c] > 0) grid_.rigid[nodes[c]] = std::uint8_t(p.body[i] + 1);
+      if (N[c] > 0) grid_.rigid[nodes[c]] = rigid_mark_[p.body[i]];
   }
 }
 

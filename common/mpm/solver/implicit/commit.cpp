@@ -109,9 +109,10 @@ void ImplicitSolver<GridT>::reactions(const nk::Vector& u) {
     const int mark = grid_.rigid[n];
     if (mark == 0 || !(grid_.m[n] > node_mass_floor_)) continue;
     const Vec<D> F = force_on_support(n);
-    const std::uint8_t held = rigid_held_[mark - 1];  // the other components slip
+    const std::uint32_t body = marked_body_[mark - 1];
+    const std::uint8_t held = rigid_held_[body];  // the other components slip
     for (int a = 0; a < D; ++a)
-      if (held >> a & 1) book_rigid_force(mark - 1, a, F[a]);
+      if (held >> a & 1) book_rigid_force(int(body), a, F[a]);
   }
 }
 

@@ -172,7 +172,7 @@ void ImplicitSolver<GridT>::p2g() {
         if (rigid(i)) {  // rigid bodies impose their velocity on the nodes they touch
           if (has_rigid_)
             for (int c = 0; c < nn; ++c)
-              if (N[c] > 0) grid_.rigid[nd[c]] = std::uint8_t(p.body[i] + 1);
+              if (N[c] > 0) grid_.rigid[nd[c]] = rigid_mark_[p.body[i]];
           continue;
         }
         const double m_p = p.m[i], V_p = m_p / p.rho[i];
@@ -227,10 +227,11 @@ void ImplicitSolver<GridT>::free_dofs() {
   if (has_rigid_)
     for (std::size_t n = 0; n < nodes; ++n)
       if (grid_.rigid[n] && grid_.m[n] > node_mass_floor_) {
-        const std::uint8_t body = rigid_held_[grid_.rigid[n] - 1];
+        const std::uint32_t b = marked_body_[grid_.rigid[n] - 1];
+        const std::uint8_t body = rigid_held_[b];
         held_[n] |= body;
         face_held_[n] &= std::uint8_t(~body);  // the body takes these components' force
-        const Vec<D>& vb = rigid_velocity_[grid_.rigid[n] - 1];
+        const Vec<D>& vb = rigid_velocity_[b];
         for (int a = 0; a < D; ++a)
           if (body >> a & 1) v_bc_[n][a] = vb[a];
       }
