@@ -172,7 +172,7 @@ std::string scene(const std::uint8_t* data, std::size_t size) {
 }
 
 std::string mesh(const std::uint8_t* data, std::size_t size) {
-  std::string first;
+  std::string errors;
   for (const char* ext : {".stl", ".obj", ".off"}) {
     Scene s;
     s.source = "fuzz.toml";
@@ -192,10 +192,10 @@ std::string mesh(const std::uint8_t* data, std::size_t size) {
       (void)region.classify_box(lo, 0.5 * (lo + hi));
       return "";  // read whole in one of the formats
     } catch (const InputError& e) {
-      if (first.empty()) first = e.what();
+      errors += std::string(errors.empty() ? "" : "\n") + e.what();
     }
   }
-  return first;
+  return errors;
 }
 
 std::string stream(const std::uint8_t* data, std::size_t size) {

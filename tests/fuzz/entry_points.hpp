@@ -16,7 +16,8 @@ std::string scene(const std::uint8_t* data, std::size_t size);
 
 /// A mesh file, read as STL (ASCII or binary), OBJ and OFF in turn as mpm-prep reads a mesh
 /// body (MeshRegion: read, repaired, checked closed and free of self-intersections), then its
-/// volume, bounds and an inside test. "" when one of the formats reads it whole.
+/// volume, bounds and an inside test. "" when one of the formats reads it whole, else the three
+/// errors, one a line.
 std::string mesh(const std::uint8_t* data, std::size_t size);
 
 /// A model or result stream, every record decoded (frames, checkpoints, escapes, grids,

@@ -30,6 +30,7 @@
 #include "mpm/core/error.hpp"
 #include "mpm/core/units.hpp"
 #include "mpm/prep/body_placement.hpp"
+#include "mpm/prep/mesh_file_checks.hpp"
 
 // Several OpenMP threads query one AABB tree. CGAL guards its lazily built structures only
 // when it knows threads exist; without CGAL_HAS_THREADS it may use unguarded statics.
@@ -78,6 +79,7 @@ Mesh read_placed_mesh(const BodySpec& body, const Scene& scene) {
 
   std::vector<Point> points;
   std::vector<std::vector<std::size_t>> polygons;
+  if (ext == ".off") check_off_faces(path, at, name);
   bool ok = false;
   try {
     ok = CGAL::IO::read_polygon_soup(path, points, polygons, CGAL::parameters::verbose(false));
@@ -163,7 +165,10 @@ std::string describe_holes(const Mesh& mesh, const BodySpec& body) {
     ++holes;
     Vec3 c = Vec3::Zero();
     std::size_t edges = 0;
-    for (auto g : CGAL::halfedges_around_face(h, mesh)) {
+    // Along the border by next(), stopping at an edge already walked: a hole's cycle need
+    // not come back to h on a mesh the soup repair left odd (a loop that never did was found
+    // by fuzz_mesh), so each border edge is walked once at most.
+    for (auto g = h; mesh.is_border(g) && !seen[g.idx()]; g = mesh.next(g)) {
       seen[g.idx()] = true;
       const Point& p = mesh.point(mesh.target(g));
       c += Vec3(p.x(), p.y(), p.z());

@@ -51,6 +51,7 @@ struct Reader {
   void get_all(std::vector<T>& v, std::size_t n) {
     if (n > (b.size() - at) / sizeof(T)) need(n * sizeof(T));
     v.resize(n);
+    if (n == 0) return;  // memcpy from or to null (an empty vector's data) is undefined
     std::memcpy(v.data(), b.data() + at, n * sizeof(T));
     at += n * sizeof(T);
   }
