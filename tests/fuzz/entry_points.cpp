@@ -27,16 +27,23 @@ namespace {
 namespace fs = std::filesystem;
 
 /// A directory of this process for the files the readers open by name (in memory when
-/// /dev/shm exists).
+/// /dev/shm exists), removed when the process ends.
 const fs::path& scratch() {
-  static const fs::path dir = [] {
-    const fs::path base =
-        fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : fs::temp_directory_path();
-    fs::path d = base / ("mpm-fuzz-" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
+  struct Dir {
+    fs::path path;
+    Dir() {
+      const fs::path base =
+          fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : fs::temp_directory_path();
+      path = base / ("mpm-fuzz-" + std::to_string(::getpid()));
+      fs::create_directories(path);
+    }
+    ~Dir() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  };
+  static const Dir dir;
+  return dir.path;
 }
 
 fs::path write_scratch(const std::string& name, const void* data, std::size_t size) {
