@@ -71,7 +71,7 @@ void ExplicitSolver<GridT>::scatter_to_grid() {
       if constexpr (kF) t.a[n] += df;
     };
   };
-  auto particle_body = [&](std::uint32_t i, const Target& t, bool, int) {
+  auto particle_body = [&] [[gnu::flatten]] (std::uint32_t i, const Target& t, bool, int) {
     if (rigid(i)) return;
     std::int64_t key, nodes[NMAX];
     Vec<D> xi;
@@ -82,7 +82,8 @@ void ExplicitSolver<GridT>::scatter_to_grid() {
         return add_to_field<F>(p, i, f, key, xi, nodes, nn);
     contribute(i, key, xi, nn, to_target(t, nodes));
   };
-  auto bin_body = [&](int, std::uint32_t bi, const Target& t, std::vector<std::uint32_t>* strays) {
+  auto bin_body = [&] [[gnu::flatten]] (int, std::uint32_t bi, const Target& t,
+                                        std::vector<std::uint32_t>* strays) {
     const Bin& bin = bins[bi];
     const int layer = grid_.layer(bin.key);
     std::int64_t nodes[NMAX];
