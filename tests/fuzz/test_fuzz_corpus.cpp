@@ -159,9 +159,13 @@ TEST(FuzzFindings, OpenMeshWhoseBorderLoopsIsRefusedAtOnce) {
 
 // A GRID record (CRC corrected by the harness) with an empty section: decode_grid copied zero
 // bytes into an empty vector's null data(), undefined behaviour (UBSan: grid_record.cpp:54).
-// Empty sections are skipped; the stream is read to its first damage.
+// Empty sections are skipped; the stream is read to its first damage. The record here has
+// every section empty (no nodes, cells or optional nodes), as the fuzzer's input had one.
 TEST(FuzzFindings, GridRecordWithAnEmptySectionDecodes) {
-  const std::string b = bytes_of(kCorpus / "stream" / "finding_grid_empty_section.mpm");
+  const std::string payload = le<std::int64_t>(0) + le<double>(0) + le<std::uint16_t>(2) +
+                              le<std::uint16_t>(1) + le<std::uint32_t>(0) +
+                              le<std::uint64_t>(0) + le<std::uint64_t>(0) + le<std::uint64_t>(0);
+  const std::string b = stream_with("GRID", payload.size(), payload) + std::string(4, '\0');
   std::string message;
   EXPECT_NO_THROW(message = feed(stream, b));
   EXPECT_NE(message.find("stream.mpm: "), std::string::npos) << message;
