@@ -163,8 +163,8 @@ TEST(FuzzFindings, OpenMeshWhoseBorderLoopsIsRefusedAtOnce) {
 // every section empty (no nodes, cells or optional nodes), as the fuzzer's input had one.
 TEST(FuzzFindings, GridRecordWithAnEmptySectionDecodes) {
   const std::string payload = le<std::int64_t>(0) + le<double>(0) + le<std::uint16_t>(2) +
-                              le<std::uint16_t>(1) + le<std::uint32_t>(0) +
-                              le<std::uint64_t>(0) + le<std::uint64_t>(0) + le<std::uint64_t>(0);
+                              le<std::uint16_t>(1) + le<std::uint32_t>(0) + le<std::uint64_t>(0) +
+                              le<std::uint64_t>(0) + le<std::uint64_t>(0);
   const std::string b = stream_with("GRID", payload.size(), payload) + std::string(4, '\0');
   std::string message;
   EXPECT_NO_THROW(message = feed(stream, b));
