@@ -1054,6 +1054,30 @@ TEST_F(VoxeliseMesh, BoxMeshGivesExactlyTheBoxPrimitiveParticles) {
     ASSERT_NEAR((position(sm, p) - position(sp, p)).norm(), 0, 1e-12) << p;
 }
 
+// Shared vertices a hair apart (issue 26: an STL with vertices 1e-18 m apart was "not closed"):
+// the unit cube [0, 1]^3 where one face uses a copy of the corner (0, 0, 0) moved by 1e-18 m.
+// Vertices within 1e-7 of the mesh's diagonal are one vertex, so the cube is closed and has its
+// volume (exact for a cube: 1e-12 is round-off).
+TEST_F(VoxeliseMesh, VerticesAHairApartAreWelded) {
+  const fs::path path = dir_ / "hair.off";
+  {
+    FILE* out = std::fopen(path.c_str(), "w");
+    ASSERT_TRUE(out);
+    std::fprintf(out, "OFF\n9 12 0\n");
+    for (int k = 0; k < 8; ++k) std::fprintf(out, "%d %d %d\n", k & 1, (k >> 1) & 1, k >> 2);
+    std::fprintf(out, "%.17g 0 0\n", 1e-18);
+    const int f[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                          {2, 6, 7}, {2, 7, 3}, {8, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+    for (const auto& t : f) std::fprintf(out, "3 %d %d %d\n", t[0], t[1], t[2]);
+    std::fclose(out);
+  }
+  Scene s = make_scene(3, 0.1, Vec3(-1, -1, -1), Vec3(2, 2, 2));
+  s.bodies = {mesh_body("cube", path.string())};
+  EXPECT_NEAR(make_region(s.bodies[0], s)->volume(), 1.0, 1e-12);
+  const Voxels r = run(s);
+  EXPECT_EQ(r.store.size(), std::size_t(20 * 20 * 20));  // 10 cells, 2 points each, per axis
+}
+
 TEST_F(VoxeliseMesh, MeshRelativeToTheSceneDirectory) {
   Scene s = make_scene(3, 0.1, Vec3(-1, -1, -1), Vec3(1, 1, 1));
   s.directory = std::string(MPM_TEST_DATA) + "/meshes";

@@ -22,9 +22,11 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <exception>
 #include <filesystem>
 #include <optional>
+#include <unordered_map>
 #include <vector>
 
 #include "mpm/core/error.hpp"
@@ -49,6 +51,50 @@ using Mesh = CGAL::Surface_mesh<Point>;
 using Primitive = CGAL::AABB_face_graph_triangle_primitive<Mesh>;
 using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
 using Side = CGAL::Side_of_triangle_mesh<Mesh, K, CGAL::Default, Tree>;
+
+/// Vertices this close (a fraction of the mesh's bounding-box diagonal, in each coordinate) are
+/// one vertex: exporters and unit conversions leave shared vertices a hair apart (an STL with
+/// vertices 1e-18 m apart read as "not closed"). 1e-7 is float32's resolution, the precision of
+/// binary STL, and far below any particle spacing.
+constexpr double kWeldTolerance = 1e-7;
+
+/// Moves each vertex within `tol` (in every coordinate) of an earlier one onto it, so that the
+/// soup repair merges them; returns how many moved. A hash of cells of side tol, searched in
+/// the 27 around each vertex.
+std::size_t weld_vertices(std::vector<Point>& points, double tol) {
+  if (points.empty() || !(tol > 0)) return 0;
+  double lo[3] = {points[0].x(), points[0].y(), points[0].z()};
+  for (const Point& p : points)
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]);
+  auto cell = [&](const Point& p, int a) { return std::int64_t(std::floor((p[a] - lo[a]) / tol)); };
+  auto key = [](std::int64_t i, std::int64_t j, std::int64_t k) {
+    return (std::uint64_t(i) * 73856093u) ^ (std::uint64_t(j) * 19349663u) ^
+           (std::uint64_t(k) * 83492791u);
+  };
+  std::unordered_multimap<std::uint64_t, std::size_t> cells;
+  std::size_t moved = 0;
+  for (std::size_t n = 0; n < points.size(); ++n) {
+    const std::int64_t c[3] = {cell(points[n], 0), cell(points[n], 1), cell(points[n], 2)};
+    std::optional<std::size_t> hit;
+    for (int d = 0; d < 27 && !hit; ++d) {
+      const auto range =
+          cells.equal_range(key(c[0] + d % 3 - 1, c[1] + d / 3 % 3 - 1, c[2] + d / 9 - 1));
+      for (auto it = range.first; it != range.second && !hit; ++it) {
+        const Point& q = points[it->second];
+        if (std::abs(q.x() - points[n].x()) <= tol && std::abs(q.y() - points[n].y()) <= tol &&
+            std::abs(q.z() - points[n].z()) <= tol)
+          hit = it->second;
+      }
+    }
+    if (hit) {
+      if (points[n] != points[*hit]) ++moved;
+      points[n] = points[*hit];
+    } else {
+      cells.emplace(key(c[0], c[1], c[2]), n);
+    }
+  }
+  return moved;
+}
 
 std::string lower_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -101,6 +147,14 @@ Mesh read_placed_mesh(const BodySpec& body, const Scene& scene) {
     if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z()))
       throw InputError(at, "mesh " + name + " has a vertex that is not a finite number");
 
+  {
+    CGAL::Bbox_3 box;
+    for (const Point& p : points) box += p.bbox();
+    const double diagonal =
+        std::sqrt(CGAL::square(box.xmax() - box.xmin()) + CGAL::square(box.ymax() - box.ymin()) +
+                  CGAL::square(box.zmax() - box.zmin()));
+    weld_vertices(points, kWeldTolerance * diagonal);
+  }
   Mesh mesh;
   try {
     // Merge duplicate vertices (STL repeats them per triangle), drop degenerate polygons,
