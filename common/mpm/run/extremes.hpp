@@ -36,8 +36,8 @@ class MaterialExtremes {
     const auto* sigma = reinterpret_cast<const double*>(sc->data());
     const auto* v = reinterpret_cast<const double*>(vc->data());
     const int dv = vc->info().components;
-    const double* eps = optional(p, col::eps_p);
-    const double* T = optional(p, col::T);
+    const double* eps = p.get<double>(col::eps_p);  // nullptr when no material needs it
+    const double* T = p.get<double>(col::T);
     for (std::size_t i = 0; i < p.size(); ++i) {
       if (mat[i] >= rows_.size()) continue;  // rigid particles
       Row& r = rows_[mat[i]];
@@ -95,10 +95,6 @@ class MaterialExtremes {
     double T = -std::numeric_limits<double>::infinity();
     bool seen = false;
   };
-  static const double* optional(const ColumnStore& p, const std::string& name) {
-    const Column* c = p.find(name);
-    return c ? reinterpret_cast<const double*>(c->data()) : nullptr;
-  }
   const Scene& scene_;
   std::vector<Row> rows_;
   int samples_ = 0;

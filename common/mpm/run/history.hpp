@@ -146,10 +146,9 @@ class History {
     std::vector<double> sum(bodies_.size() * per, 0.0);
     const std::size_t n = particles.size();
     const BodyIds body(particles.find(col::body));
-    const auto* m = reinterpret_cast<const double*>(particles.at(col::m).data());
-    const auto* v = reinterpret_cast<const double*>(particles.at(col::v).data());
-    const Column* ec = particles.find(col::e);
-    const double* e = ec ? reinterpret_cast<const double*>(ec->data()) : nullptr;
+    const double* m = particles.get<double>(col::m);
+    const auto* v = reinterpret_cast<const double*>(particles.at(col::v).data());  // dim_ a row
+    const double* e = particles.get<double>(col::e);  // nullptr without the column
     for (std::size_t i = 0; i < n; ++i) {
       const int k = slot_[body[i]];
       if (k < 0) continue;
