@@ -398,7 +398,7 @@ TEST(SceneErrors, FilesNameFileLineAndKey) {
       {"bad_syntax.toml", 3, "TOML syntax error: "},
       {"bad_unknown_key.toml", 7,
        "materials.copper.densty: unknown key (expected one of: density, youngs_modulus, "
-       "poisson_ratio, strength, eos, failure)"},
+       "poisson_ratio, shear_modulus, strength, eos, failure)"},
       {"bad_unknown_top.toml", 19,
        "outptu: unknown key (expected one of: scene, materials, bodies, loads, contact, grid, "
        "boundary, "
@@ -560,7 +560,7 @@ TEST(SceneErrors, InlineCases) {
        "materials.copper.strength.C: not used by the j2 model (only by \"johnson-cook\")"},
       {"unknown strength model", mat_end, mat_end + "\nstrength.model = \"jc\"", "strength",
        "materials.copper.strength.model: expected one of \"elastic\", \"j2\", \"johnson-cook\", "
-       "\"bilinear\", got 'jc'"},
+       "\"bilinear\", \"hjc\", got 'jc'"},
       {"bilinear with A", mat_end,
        mat_end + "\n[materials.copper.strength]\nmodel = \"bilinear\"\nyield_stress = "
                  "\"1.43 GPa\"\ntangent_modulus = \"14.759 GPa\"\nA = 1e8",

@@ -12,6 +12,8 @@ ColumnNeeds column_needs(const Scene& scene) {
     if (mat.strength.model != StrengthModel::Elastic) need.eps_p = true;
     if (mat.strength.thermal()) need.T = true;
     if (mat.failure.enabled()) need.failed = need.eps_p = true;
+    if (mat.strength.model == StrengthModel::Hjc) need.damage = true;
+    if (mat.eos.model == EosModel::Hjc) need.mu_max = true;
   }
   return need;
 }
@@ -78,6 +80,8 @@ void prepare_columns(ColumnStore& cols, const Scene& scene) {
   const ColumnNeeds need = column_needs(scene);
   if (need.eps_p) ensure(cols, {col::eps_p, ScalarType::F64, 1, "-"});
   if (need.failed) ensure(cols, {col::failed, ScalarType::U8, 1, "-"});
+  if (need.damage) ensure(cols, {col::damage, ScalarType::F64, 1, "-"});
+  if (need.mu_max) ensure(cols, {col::mu_max, ScalarType::F64, 1, "-"});
   if (!scene.grid.levels.empty()) {
     // Graded grids: the strain that places split children (004, eq. 23) and each particle's
     // level (0 = not yet known: the level it starts in, set by the first split pass).
@@ -136,6 +140,8 @@ ParticleView<D> view(ColumnStore& cols) {
   p.eps_p = cols.get<double>(col::eps_p);
   p.T = cols.get<double>(col::T);
   p.failed = cols.get<std::uint8_t>(col::failed);
+  p.damage = cols.get<double>(col::damage);
+  p.mu_max = cols.get<double>(col::mu_max);
   p.f_ext = cols.get<Vec<D>>(col::f_ext);
   p.strain = cols.get<Vec<D>>(col::strain);
   p.thickness = cols.get<double>(col::thickness);
@@ -152,7 +158,8 @@ double run_particle_bytes(const Scene& scene) {
   const int d = scene.dimension;
   // x and v, m, rho and e, sigma, id, material and body, then the optional columns.
   return 2 * d * 8 + 3 * 8 + 48 + 4 + 1 + 1 + (need.eps_p ? 8 : 0) + (need.T ? 8 : 0) +
-         (need.failed ? 1 : 0) + (d == 2 && scene.plane_stress ? 8 : 0);
+         (need.failed ? 1 : 0) + (need.damage ? 8 : 0) + (need.mu_max ? 8 : 0) +
+         (d == 2 && scene.plane_stress ? 8 : 0);
 }
 
 }  // namespace mpm

@@ -1,7 +1,7 @@
 #pragma once
 /// Particles are named columns (structure of arrays) kept in cell order. Only the columns the
 /// scene's materials need exist: no eps_p without plasticity, no T without thermal softening,
-/// no failed flag without a failure model.
+/// no failed flag without a failure model, no damage or mu_max without HJC concrete.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -26,6 +26,8 @@ inline const std::string e = "e";                ///< f64, specific internal ene
 inline const std::string eps_p = "eps_p";        ///< f64, equivalent plastic strain
 inline const std::string T = "T";                ///< f64, temperature, K
 inline const std::string failed = "failed";      ///< u8, 1 once the failure criterion was met
+inline const std::string damage = "damage";      ///< f64, HJC damage D in [0, 1]
+inline const std::string mu_max = "mu_max";      ///< f64, HJC: largest compression rho/rho0 - 1
 inline const std::string f_ext = "f_ext";        ///< D x f64, applied force (loads), N
 inline const std::string strain = "strain";  ///< D x f64, accumulated normal strains (graded grids)
 inline const std::string level =
@@ -70,6 +72,8 @@ struct ParticleView {
   double* eps_p = nullptr;
   double* T = nullptr;
   std::uint8_t* failed = nullptr;
+  double* damage = nullptr;  ///< HJC damage
+  double* mu_max = nullptr;  ///< HJC largest compression
   Vec<D>* f_ext = nullptr;
   Vec<D>* strain = nullptr;     ///< integral of the rate of deformation's diagonal (graded grids)
   double* thickness = nullptr;  ///< thickness / initial thickness (plane stress)
@@ -83,6 +87,8 @@ struct ColumnNeeds {
   bool eps_p = false;
   bool T = false;
   bool failed = false;
+  bool damage = false;  ///< HJC strength
+  bool mu_max = false;  ///< HJC pressure (its unloading path)
 };
 ColumnNeeds column_needs(const Scene& scene);
 

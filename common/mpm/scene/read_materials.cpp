@@ -12,12 +12,44 @@ namespace mpm::scene_toml {
 
 namespace {
 
-void read_strength(Reader& r, StrengthSpec& s) {
+const std::initializer_list<std::string_view> kHjcStrengthKeys = {"N",  "fc", "T",     "S_max",
+                                                                  "D1", "D2", "EF_min"};
+
+// HJC strength and damage (Holmquist, Johnson & Cook 1993); the constants of 004 Table 4 are
+// the examples.
+void read_hjc_strength(Reader& r, HjcSpec& h) {
+  r.reject({"n", "m", "room_temperature", "melt_temperature", "specific_heat", "taylor_quinney",
+            "yield_stress", "tangent_modulus"},
+           "by the hjc model (its keys: A, B, N, C, fc, T, S_max, reference_rate, D1, D2, EF_min)");
+  h.A = r.required("A", dim::none, Bound::NonNegative, "0.79", "normalised cohesion");
+  h.B = r.required("B", dim::none, Bound::NonNegative, "1.60", "normalised pressure hardening");
+  h.N = r.required("N", dim::none, Bound::Positive, "0.61", "pressure hardening exponent");
+  h.C = r.required("C", dim::none, Bound::NonNegative, "0.007", "strain-rate coefficient");
+  h.fc = r.required("fc", dim::pressure, Bound::Positive, "48 MPa",
+                    "the quasi-static uniaxial compressive strength f'c");
+  h.T = r.required("T", dim::pressure, Bound::Positive, "4 MPa", "the tensile strength");
+  h.S_max =
+      r.required("S_max", dim::none, Bound::Positive, "7.0", "the cap on the normalised strength");
+  h.reference_rate = r.quantity("reference_rate", dim::rate, Bound::Positive).value_or(1.0);
+  h.D1 = r.required("D1", dim::none, Bound::NonNegative, "0.04", "damage constant");
+  h.D2 = r.required("D2", dim::none, Bound::NonNegative, "1.0", "damage exponent");
+  h.EF_min = r.required("EF_min", dim::none, Bound::Positive, "0.01",
+                        "the least plastic strain to fracture");
+  r.finish();
+}
+
+void read_strength(Reader& r, StrengthSpec& s, HjcSpec& h) {
   s.model = r.choice<StrengthModel>("model", {{"elastic", StrengthModel::Elastic},
                                               {"j2", StrengthModel::J2},
                                               {"johnson-cook", StrengthModel::JohnsonCook},
-                                              {"bilinear", StrengthModel::Bilinear}})
+                                              {"bilinear", StrengthModel::Bilinear},
+                                              {"hjc", StrengthModel::Hjc}})
                 .value_or(StrengthModel::Elastic);
+  if (s.model == StrengthModel::Hjc) {
+    read_hjc_strength(r, h);
+    return;
+  }
+  r.reject(kHjcStrengthKeys, "by this model (only by \"hjc\")");
   const std::initializer_list<std::string_view> jc_only = {"C",
                                                            "reference_rate",
                                                            "m",
@@ -85,6 +117,32 @@ const std::initializer_list<std::string_view> kMieGruneisenKeys = {"c0", "s", "g
                                                                    "energy_in_expansion"};
 const std::initializer_list<std::string_view> kTillotsonKeys = {
     "a", "b", "A", "B", "E0", "E_iv", "E_cv", "alpha", "beta"};
+const std::initializer_list<std::string_view> kHjcEosKeys = {
+    "P_crush", "mu_crush", "P_lock", "mu_lock", "K1", "K2", "K3"};
+
+// HJC's three-region pressure: elastic to (mu_crush, P_crush), crushing to P_lock, fully dense
+// p = K1 mubar + K2 mubar^2 + K3 mubar^3, mubar = (mu - mu_lock) / (1 + mu_lock).
+void read_hjc_eos(Reader& r, HjcSpec& h) {
+  h.P_crush = r.required("P_crush", dim::pressure, Bound::Positive, "16 MPa");
+  h.mu_crush = r.required("mu_crush", dim::none, Bound::Positive, "0.001");
+  h.P_lock = r.required("P_lock", dim::pressure, Bound::Positive, "0.80 GPa");
+  h.mu_lock = r.required("mu_lock", dim::none, Bound::Positive, "0.10",
+                         "the fully dense curve's zero-pressure strain");
+  h.K1 = r.required("K1", dim::pressure, Bound::Positive, "85 GPa");
+  h.K2 = r.required("K2", dim::pressure, Bound::Any, "-171 GPa");
+  h.K3 = r.required("K3", dim::pressure, Bound::Any, "208 GPa");
+  r.check("mu_lock", h.mu_lock > h.mu_crush,
+          "must be above mu_crush (" + format_number(h.mu_crush) + ")");
+  r.check("P_lock", h.P_lock > h.P_crush,
+          "must be above P_crush (" + format_number(h.P_crush) + " Pa)");
+  // The fully dense curve rises for every mubar > 0: its slope K1 + 2 K2 m + 3 K3 m^2 stays
+  // positive (K3 > 0 with K2 >= 0 or K2^2 < 3 K1 K3; K3 = 0 with K2 >= 0).
+  const bool rising =
+      h.K3 > 0 ? (h.K2 >= 0 || h.K2 * h.K2 < 3.0 * h.K1 * h.K3) : (h.K3 == 0 && h.K2 >= 0);
+  r.check("K2", rising,
+          "with K1 and K3 the fully dense curve K1 mubar + K2 mubar^2 + K3 mubar^3 must rise for "
+          "every mubar > 0 (K3 >= 0, and K2^2 < 3 K1 K3 when K2 < 0)");
+}
 
 // Tillotson's constants, each required (docs/eos-tillotson.md derives lead's).
 void read_tillotson(Reader& r, TillotsonSpec& t) {
@@ -100,12 +158,18 @@ void read_tillotson(Reader& r, TillotsonSpec& t) {
   r.check("E_cv", t.E_cv > t.E_iv, "must be above E_iv (" + format_number(t.E_iv) + " J/kg)");
 }
 
-void read_eos(Reader& r, EosSpec& e) {
+void read_eos(Reader& r, EosSpec& e, HjcSpec& h) {
   e.model = r.choice<EosModel>("model", {{"linear", EosModel::Linear},
                                          {"mie-gruneisen", EosModel::MieGruneisen},
-                                         {"tillotson", EosModel::Tillotson}})
+                                         {"tillotson", EosModel::Tillotson},
+                                         {"hjc", EosModel::Hjc}})
                 .value_or(EosModel::Linear);
-  if (e.model == EosModel::Linear) {
+  if (e.model != EosModel::Hjc) r.reject(kHjcEosKeys, "by this model (only by \"hjc\")");
+  if (e.model == EosModel::Hjc) {
+    r.reject(kMieGruneisenKeys, "by the hjc model (set model = \"mie-gruneisen\")");
+    r.reject(kTillotsonKeys, "by the hjc model (set model = \"tillotson\")");
+    read_hjc_eos(r, h);
+  } else if (e.model == EosModel::Linear) {
     r.reject(kMieGruneisenKeys, "by the linear model (set model = \"mie-gruneisen\")");
     r.reject(kTillotsonKeys, "by the linear model (set model = \"tillotson\")");
   } else if (e.model == EosModel::Tillotson) {
@@ -178,33 +242,90 @@ void check_plausible(const Reader& r, const MaterialSpec& m, const SourceLoc& yi
     plausible(warnings, c0_at, m.eos.c0, {100, 20000, "100 to 20 000 m/s", "m/s", {{"km/s", 1e3}}});
 }
 
+/// HJC: strength and eos both "hjc" (the damage of one cuts the tension of the other), its
+/// elasticity from shear_modulus and K = P_crush / mu_crush (E and nu follow); no failure table
+/// (damage is its failure).
+void check_hjc(Reader& r, MaterialSpec& m, bool by_shear, double G) {
+  const bool s = m.strength.model == StrengthModel::Hjc, e = m.eos.model == EosModel::Hjc;
+  if (!s && !e) {
+    if (by_shear)
+      r.fail("shear_modulus",
+             "is for HJC concrete (strength.model and eos.model = \"hjc\"); other materials "
+             "give youngs_modulus and poisson_ratio");
+    return;
+  }
+  if (!s || !e)
+    r.fail_table(std::string("HJC concrete needs both strength.model and eos.model = \"hjc\" "
+                             "(its damage softens the strength and cuts the tension), got ") +
+                 (s ? "eos.model" : "strength.model") + " of another model");
+  if (!by_shear)
+    r.fail_table(
+        "missing required key 'shear_modulus' (a pressure, e.g. \"14.86 GPa\"): HJC concrete "
+        "gives its shear modulus; its bulk modulus is eos.P_crush / eos.mu_crush");
+  if (m.failure.enabled())
+    r.fail("failure", "not used by HJC concrete (its damage D is its failure)");
+  const double K = m.hjc.K_elastic();
+  m.youngs_modulus = 9.0 * K * G / (3.0 * K + G);
+  m.poisson_ratio = (3.0 * K - 2.0 * G) / (2.0 * (3.0 * K + G));
+}
+
 MaterialSpec read_material(Reader& r, const std::string& name, std::vector<std::string>& warnings) {
   MaterialSpec m;
   m.name = name;
   m.loc = r.loc();
   m.density = r.required("density", dim::density, Bound::Positive, "8930 kg/m^3");
-  m.youngs_modulus = r.required("youngs_modulus", dim::pressure, Bound::Positive, "117 GPa");
-  m.poisson_ratio = r.required("poisson_ratio", dim::none, Bound::Any, "0.35");
-  r.check("poisson_ratio", m.poisson_ratio > -1, "must be above -1");
-  r.check("poisson_ratio", m.poisson_ratio < 0.5,
-          "must be below 0.5 (incompressible materials are not supported)");
+  // HJC concrete gives its shear modulus; its bulk modulus is P_crush / mu_crush (below).
+  const bool by_shear = r.has("shear_modulus");
+  double G = 0;
+  if (by_shear) {
+    G = r.required("shear_modulus", dim::pressure, Bound::Positive, "14.86 GPa");
+    r.reject({"youngs_modulus", "poisson_ratio"},
+             "with shear_modulus (HJC concrete: its bulk modulus is eos.P_crush / eos.mu_crush)");
+  } else {
+    m.youngs_modulus = r.required("youngs_modulus", dim::pressure, Bound::Positive, "117 GPa");
+    m.poisson_ratio = r.required("poisson_ratio", dim::none, Bound::Any, "0.35");
+    r.check("poisson_ratio", m.poisson_ratio > -1, "must be above -1");
+    r.check("poisson_ratio", m.poisson_ratio < 0.5,
+            "must be below 0.5 (incompressible materials are not supported)");
+  }
   SourceLoc yield_at, c0_at;
-  if (auto t = r.table("strength", {"model", "A", "B", "n", "C", "reference_rate", "m",
-                                    "room_temperature", "melt_temperature", "specific_heat",
-                                    "taylor_quinney", "yield_stress", "tangent_modulus"})) {
-    read_strength(*t, m.strength);
+  if (auto t = r.table("strength", {"model",
+                                    "A",
+                                    "B",
+                                    "n",
+                                    "C",
+                                    "reference_rate",
+                                    "m",
+                                    "room_temperature",
+                                    "melt_temperature",
+                                    "specific_heat",
+                                    "taylor_quinney",
+                                    "yield_stress",
+                                    "tangent_modulus",
+                                    "N",
+                                    "fc",
+                                    "T",
+                                    "S_max",
+                                    "D1",
+                                    "D2",
+                                    "EF_min"})) {
+    read_strength(*t, m.strength, m.hjc);
     const bool bilinear = m.strength.model == StrengthModel::Bilinear;
     yield_at = t->loc_of(bilinear ? "yield_stress" : "A");
     if (bilinear)
       t->check("tangent_modulus", m.strength.tangent_modulus < m.youngs_modulus,
                "must be below youngs_modulus (" + format_number(m.youngs_modulus) + " Pa)");
   }
-  if (auto t = r.table("eos", {"model", "c0", "s", "gamma0", "energy_in_expansion", "a", "b", "A",
-                               "B", "E0", "E_iv", "E_cv", "alpha", "beta"})) {
-    read_eos(*t, m.eos);
+  if (auto t = r.table("eos", {"model",    "c0",     "s",       "gamma0", "energy_in_expansion",
+                               "a",        "b",      "A",       "B",      "E0",
+                               "E_iv",     "E_cv",   "alpha",   "beta",   "P_crush",
+                               "mu_crush", "P_lock", "mu_lock", "K1",     "K2",
+                               "K3"})) {
+    read_eos(*t, m.eos, m.hjc);
     c0_at = t->loc_of("c0");
   }
   if (auto t = r.table("failure", {"plastic_strain", "pressure"})) read_failure(*t, m.failure);
+  check_hjc(r, m, by_shear, G);
   r.finish();
   check_plausible(r, m, yield_at, c0_at, warnings);
   return m;
@@ -235,7 +356,8 @@ void read_materials(Reader& top, Scene& s) {
       throw InputError(doc.where(o, path), "expected a table ([" + path + "]), " + got(node));
     }
     Reader r(doc, *t, path, o,
-             {"density", "youngs_modulus", "poisson_ratio", "strength", "eos", "failure"});
+             {"density", "youngs_modulus", "poisson_ratio", "shear_modulus", "strength", "eos",
+              "failure"});
     s.materials.push_back(read_material(r, std::string(name.str()), s.warnings));
   }
 }

@@ -101,6 +101,11 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
                      "contact between bodies needs the explicit solver (solver.type = "
                      "\"explicit\"); the implicit solver has one velocity field");
   }
+  if (s.solver.type == SolverType::Implicit)
+    for (const MaterialSpec& m : s.materials)
+      if (m.strength.model == StrengthModel::Hjc)
+        throw InputError(where(m.loc.file, m.loc.line, m.loc.key),
+                         "HJC concrete needs the explicit solver (solver.type = \"explicit\")");
   top.finish();
 }
 

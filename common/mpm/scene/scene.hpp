@@ -19,8 +19,8 @@ struct SourceLoc {
   std::string key;  ///< dotted path, e.g. "materials.copper.density"
 };
 
-enum class StrengthModel { Elastic, J2, JohnsonCook, Bilinear };
-enum class EosModel { Linear, MieGruneisen, Tillotson };
+enum class StrengthModel { Elastic, J2, JohnsonCook, Bilinear, Hjc };
+enum class EosModel { Linear, MieGruneisen, Tillotson, Hjc };
 
 /// Deviatoric strength. J2: sigma_y = A + B eps_p^n. Johnson-Cook multiplies by
 /// (1 + C ln(rate/rate0)) (1 - T*^m), T* = (T - T_room)/(T_melt - T_room). Bilinear: J2 with
@@ -74,6 +74,23 @@ struct FailureSpec {
   }
 };
 
+/// Holmquist-Johnson-Cook concrete (docs/scene.md, HJC concrete): its strength (strength.model
+/// = "hjc") and its pressure (eos.model = "hjc") share these constants; the two go together.
+struct HjcSpec {
+  double A = 0, B = 0, N = 1;        ///< normalised cohesion, pressure hardening and its exponent
+  double C = 0;                      ///< strain-rate coefficient
+  double fc = 0;                     ///< quasi-static uniaxial compressive strength f'c, Pa
+  double T = 0;                      ///< tensile strength, Pa
+  double S_max = 0;                  ///< cap on the normalised strength
+  double reference_rate = 1;         ///< 1/s
+  double D1 = 0, D2 = 1;             ///< damage: fracture strain D1 (P* + T*)^D2
+  double EF_min = 0;                 ///< least fracture strain
+  double P_crush = 0, mu_crush = 0;  ///< end of the elastic region, Pa and -
+  double P_lock = 0, mu_lock = 0;    ///< lock pressure (Pa), and the fully dense curve's p = 0
+  double K1 = 0, K2 = 0, K3 = 0;     ///< fully dense curve, Pa
+  double K_elastic() const { return P_crush / mu_crush; }
+};
+
 struct MaterialSpec {
   std::string name;
   double density = 0;         ///< reference density rho_0, kg/m^3
@@ -82,6 +99,7 @@ struct MaterialSpec {
   StrengthSpec strength;
   EosSpec eos;
   FailureSpec failure;
+  HjcSpec hjc;  ///< strength.model or eos.model = Hjc (both or neither)
   SourceLoc loc;
   double shear_modulus() const { return youngs_modulus / (2 * (1 + poisson_ratio)); }
   double bulk_modulus() const { return youngs_modulus / (3 * (1 - 2 * poisson_ratio)); }

@@ -397,6 +397,7 @@ MaterialBlock SolverCore<GridT>::update_block(const PendingBlock& pb, const Part
   blk.L = scr.L;
   blk.m = s.m + pb.i0;
   blk.set_state(s.sigma, s.rho, s.e, s.eps_p, s.T, s.failed, s.thickness, pb.i0);
+  blk.set_history(s.damage, s.mu_max, pb.i0);
   blk.c = scr.c;
   blk.plane_stress = plane_stress_;
   materials_[pb.mat].update(blk, scr.S);

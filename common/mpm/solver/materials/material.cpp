@@ -48,14 +48,14 @@ Material::EnergyStep Material::energy_step(const MaterialBlock& b, const BlockSc
 // solves it on the tangent at e_1, the second Newton iterate (its error is (dp/de)' (e_2 -
 // e_1)^2 k / 2, second order in the step's energy change).
 void Material::tangent_at_step_energy(const MaterialBlock& b, BlockScratch& S) const {
-  eos_->coefficients(b.n, b.rho, b.e, S.A, S.B, S.K);
+  eos_->block_coefficients(b, b.e, S.A, S.B, S.K);
   for (int i = 0; i < b.n; ++i) {
     const EnergyStep es = energy_step(b, S, i);
     const double e_star = es.e_star(b.e[i], S.s_old[i], S.s[i], S.de[i], S.P_old[i]);
     const double p = es.pressure(S.A[i], S.B[i], e_star);
     S.e_lin[i] = e_star - (p + es.q) * es.k;
   }
-  eos_->coefficients(b.n, b.rho, S.e_lin, S.A, S.B, S.K);
+  eos_->block_coefficients(b, S.e_lin, S.A, S.B, S.K);
 }
 
 std::string to_string(StrengthModel m) {
@@ -68,6 +68,8 @@ std::string to_string(StrengthModel m) {
       return "johnson-cook";
     case StrengthModel::Bilinear:
       return "bilinear";
+    case StrengthModel::Hjc:
+      return "hjc";
   }
   return "?";
 }
@@ -79,6 +81,8 @@ std::string to_string(EosModel m) {
       return "mie-gruneisen";
     case EosModel::Tillotson:
       return "tillotson";
+    case EosModel::Hjc:
+      return "hjc";
   }
   return "?";
 }
@@ -90,9 +94,11 @@ const ModelRegistry& model_registry() {
     r.strength["j2"] = make_j2_strength;
     r.strength["johnson-cook"] = make_johnson_cook_strength;
     r.strength["bilinear"] = make_bilinear_strength;
+    r.strength["hjc"] = make_hjc_strength;
     r.eos["linear"] = make_linear_eos;
     r.eos["mie-gruneisen"] = make_mie_gruneisen_eos;
     r.eos["tillotson"] = make_tillotson_eos;
+    r.eos["hjc"] = make_hjc_eos;
     return r;
   }();
   return registry;
@@ -227,7 +233,7 @@ struct ThicknessRoot {
 /// particle's root search and fault.
 struct Material::PlaneStressIteration {
   Sym sigma0[kBlock];
-  double rho0[kBlock], e0[kBlock], ep0[kBlock], T0[kBlock];
+  double rho0[kBlock], e0[kBlock], ep0[kBlock], T0[kBlock], D0[kBlock], mm0[kBlock];
   std::uint8_t f0[kBlock];
   MaterialBlock start;  ///< the state of t^n: those columns (the ones the block has)
   Mat3 L[kBlock];
@@ -242,6 +248,7 @@ void Material::update_plane_stress(MaterialBlock& b, BlockScratch& S) const {
   const double k0 = M * b.dt;  // elastic d sigma_zz / d L_zz
   it.start.set_state(it.sigma0, it.rho0, it.e0, b.eps_p ? it.ep0 : nullptr, b.T ? it.T0 : nullptr,
                      b.failed ? it.f0 : nullptr, nullptr, 0);
+  it.start.set_history(b.damage ? it.D0 : nullptr, b.mu_max ? it.mm0 : nullptr, 0);
   for (int i = 0; i < n; ++i) {
     copy_state(b, i, it.start, i);
     it.L[i] = b.L[i];
@@ -280,6 +287,7 @@ void Material::update_iterating(MaterialBlock& b, PlaneStressIteration& it, cons
                                 BlockScratch& S) const {
   Sym g_sigma[kBlock];
   double g_rho[kBlock], g_e[kBlock], g_ep[kBlock], g_T[kBlock], g_m[kBlock], g_c[kBlock];
+  double g_D[kBlock], g_mm[kBlock];
   std::uint8_t g_f[kBlock];
   Mat3 g_L[kBlock];
   MaterialBlock g = b;
@@ -288,6 +296,7 @@ void Material::update_iterating(MaterialBlock& b, PlaneStressIteration& it, cons
   g.m = g_m;
   g.set_state(g_sigma, g_rho, g_e, b.eps_p ? g_ep : nullptr, b.T ? g_T : nullptr,
               b.failed ? g_f : nullptr, nullptr, 0);
+  g.set_history(b.damage ? g_D : nullptr, b.mu_max ? g_mm : nullptr, 0);
   g.c = g_c;
   g.fault_index = -1;
   g.fault = PointFault::None;
@@ -335,11 +344,17 @@ void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
     b.rho[i] = rho_new;
   }
 
+  // A pressure-dependent strength (HJC) takes the EOS's pressure at the new density and the
+  // energy of t^n (exact for an EOS without energy; the energy equation follows below).
+  if (strength_->needs_pressure()) {
+    eos_->block_coefficients(b, b.e, S.A, S.B, S.K);
+    for (int i = 0; i < b.n; ++i) S.p[i] = S.A[i] + S.B[i] * b.e[i];
+  }
   // Deviatoric stress: elastic predictor and radial return.
   strength_->update(b, S, G_);
   // Equation of state at the new density: p = A + B e.
   if (eos_->linear_in_energy())
-    eos_->coefficients(b.n, b.rho, b.e, S.A, S.B, S.K);
+    eos_->block_coefficients(b, b.e, S.A, S.B, S.K);
   else
     tangent_at_step_energy(b, S);
 

@@ -41,6 +41,8 @@ struct MaterialBlock {
   double* eps_p = nullptr;         ///< equivalent plastic strain (in/out; nullptr if absent)
   double* T = nullptr;             ///< temperature, K (in/out; nullptr if absent)
   std::uint8_t* failed = nullptr;  ///< failure flag (in/out; nullptr if absent)
+  double* damage = nullptr;        ///< HJC damage D (in/out; nullptr if absent)
+  double* mu_max = nullptr;        ///< HJC largest compression rho/rho0 - 1 (in/out; or nullptr)
   double* c = nullptr;             ///< out: signal speed for the time step, m/s
   /// 2D plane stress: L(2, 2) on entry is ignored; the update finds the thickness rate that
   /// makes sigma_zz = 0 for each particle (and the density follows the thinning).
@@ -61,11 +63,16 @@ struct MaterialBlock {
     failed = failed_ ? failed_ + i0 : nullptr;
     thickness = thickness_ ? thickness_ + i0 : nullptr;
   }
+  /// Points the HJC history (damage, mu_max) at columns from element i0 (null when absent).
+  void set_history(double* damage_, double* mu_max_, std::size_t i0) {
+    damage = damage_ ? damage_ + i0 : nullptr;
+    mu_max = mu_max_ ? mu_max_ + i0 : nullptr;
+  }
 };
 
-/// Copies the state (sigma, rho, e and, where both have them, eps_p, T, failed and
-/// thickness) of element i of `from` to element j of `to`: particle columns (ParticleView) or
-/// a block (MaterialBlock).
+/// Copies the state (sigma, rho, e and, where both have them, eps_p, T, failed, thickness,
+/// damage and mu_max) of element i of `from` to element j of `to`: particle columns (ParticleView)
+/// or a block (MaterialBlock).
 template <class From, class To>
 void copy_state(const From& from, std::size_t i, const To& to, std::size_t j) {
   to.sigma[j] = from.sigma[i];
@@ -75,6 +82,8 @@ void copy_state(const From& from, std::size_t i, const To& to, std::size_t j) {
   if (from.T && to.T) to.T[j] = from.T[i];
   if (from.failed && to.failed) to.failed[j] = from.failed[i];
   if (from.thickness && to.thickness) to.thickness[j] = from.thickness[i];
+  if (from.damage && to.damage) to.damage[j] = from.damage[i];
+  if (from.mu_max && to.mu_max) to.mu_max[j] = from.mu_max[i];
 }
 
 /// Scratch shared by the stages of one block update (owned by the caller, one per thread).
@@ -89,6 +98,7 @@ struct BlockScratch {
   double e_lin[kBlock];    ///< EOS nonlinear in e: the energy its tangent is taken at, J/kg
   double dlambda[kBlock];  ///< plastic strain increment of this step
   double yield[kBlock];    ///< flow stress after the step, Pa
+  double p[kBlock];        ///< pressure-dependent strength: the EOS's p at the new density, Pa
 };
 
 /// Equation of state, written as p = A(rho) + B(rho) e with e the specific internal energy,
@@ -105,6 +115,12 @@ class Eos {
                             double* K) const = 0;
   /// True when A, B and K do not depend on e (one solve of the energy equation is exact).
   virtual bool linear_in_energy() const { return true; }
+  /// As coefficients() for the particles of a block at the energies e[i], with their history
+  /// (an EOS whose pressure depends on more than rho and e, as HJC's on mu_max and damage).
+  virtual void block_coefficients(const MaterialBlock& b, const double* e, double* A, double* B,
+                                  double* K) const {
+    coefficients(b.n, b.rho, e, A, B, K);
+  }
 };
 
 /// Deviatoric strength: updates s (the rotated old deviator on entry) by the deviatoric strain
@@ -115,6 +131,9 @@ class Strength {
   /// Columns this model needs beyond the basic state.
   virtual bool needs_plastic_strain() const { return false; }
   virtual bool needs_temperature() const { return false; }
+  /// True when the flow stress depends on the pressure: the update then hands the EOS's
+  /// pressure at the new density (before the energy equation) in S.p.
+  virtual bool needs_pressure() const { return false; }
   /// Elastic-predictor / plastic-corrector for a block: in S.s (rotated s_old), S.de; out S.s,
   /// S.dlambda, S.yield, blk.eps_p, blk.T (adiabatic heating).
   virtual void update(MaterialBlock& blk, BlockScratch& S, double G) const = 0;
@@ -192,8 +211,7 @@ struct ModelRegistry {
   std::map<std::string, EosFactory> eos;
 };
 /// The registry with every built-in model: strength "elastic", "j2", "johnson-cook",
-/// "bilinear";
-/// eos "linear", "mie-gruneisen", "tillotson".
+/// "bilinear", "hjc"; eos "linear", "mie-gruneisen", "tillotson", "hjc".
 const ModelRegistry& model_registry();
 /// Registry key of a scene enum.
 std::string to_string(StrengthModel m);

@@ -16,4 +16,8 @@ std::unique_ptr<Strength> make_j2_strength(const MaterialSpec& m);
 std::unique_ptr<Strength> make_johnson_cook_strength(const MaterialSpec& m);
 /// Bilinear elastic-plastic: J2 with sigma_y = A + H eps_p, H = E E_T / (E - E_T).
 std::unique_ptr<Strength> make_bilinear_strength(const MaterialSpec& m);
+/// Holmquist-Johnson-Cook concrete (hjc.cpp): the strength with its damage, and the
+/// three-region pressure with its unloading path and the damaged tension cut-off.
+std::unique_ptr<Strength> make_hjc_strength(const MaterialSpec& m);
+std::unique_ptr<Eos> make_hjc_eos(const MaterialSpec& m);
 }  // namespace mpm

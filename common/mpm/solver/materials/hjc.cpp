@@ -1,0 +1,196 @@
+// Holmquist-Johnson-Cook concrete (Holmquist, Johnson & Cook 1993, the seed 004's [42];
+// docs/scene.md, HJC concrete): a pressure-dependent strength softened by damage, and a
+// three-region pressure with crushing, locking and an unloading path.
+#include <algorithm>
+#include <cmath>
+
+#include "mpm/solver/materials/material.hpp"
+#include "mpm/solver/materials/models.hpp"
+
+namespace mpm {
+
+namespace {
+
+/// HJC's pressure against the volumetric strain mu = rho / rho0 - 1 (P in Pa):
+///   elastic     mu <= mu_crush:               P = K_e mu, K_e = P_crush / mu_crush
+///   crushing    mu_crush < mu <= mu_plock:    P linear from (mu_crush, P_crush) to
+///                                              (mu_plock, P_lock)
+///   fully dense mu > mu_plock:                P = K1 m + K2 m^2 + K3 m^3,
+///                                              m = (mu - mu_lock) / (1 + mu_lock)
+/// mu_lock is where the fully dense curve has P = 0 (the grain density's strain: 004 Table 4's
+/// 0.10 is 2680 / 2440 - 1 for a grain density 2680 kg/m^3), and mu_plock where it reaches
+/// P_lock, so that the loading curve is continuous (crushing up to (mu_lock, P_lock) and the
+/// dense curve from zero at mu_lock would drop by P_lock there). Once crushed to mu_max, the
+/// material unloads and reloads along the line from (mu_max, P(mu_max)) of modulus
+/// K_u = (1 - F) K_e + F K1, F = (mu_max - mu_crush) / (mu_plock - mu_crush); past mu_plock it
+/// follows the dense curve (K1 m below m = 0). Tension is cut at -T (1 - D).
+struct HjcPressure {
+  HjcSpec h;
+  double K_e = 0;       ///< elastic bulk modulus, Pa
+  double mu_plock = 0;  ///< end of crushing, on the fully dense curve at P_lock
+
+  explicit HjcPressure(const HjcSpec& spec) : h(spec), K_e(spec.K_elastic()) {
+    // The dense curve rises (the reader checks), so Newton from P_lock / K1 finds its one root.
+    double m = h.P_lock / h.K1;
+    for (int it = 0; it < 100; ++it) {
+      const double r = dense_of(m) - h.P_lock;
+      const double step = r / dense_slope_of(m);
+      m -= step;
+      if (std::abs(step) <= 1e-15 * std::max(m, 1e-12)) break;
+    }
+    mu_plock = h.mu_lock + (1.0 + h.mu_lock) * m;
+  }
+  double dense_of(double m) const { return m > 0 ? m * (h.K1 + m * (h.K2 + m * h.K3)) : h.K1 * m; }
+  double dense_slope_of(double m) const {
+    return m > 0 ? h.K1 + m * (2.0 * h.K2 + 3.0 * h.K3 * m) : h.K1;
+  }
+  double bar(double mu) const { return (mu - h.mu_lock) / (1.0 + h.mu_lock); }
+  double crush_slope() const { return (h.P_lock - h.P_crush) / (mu_plock - h.mu_crush); }
+  /// The loading (virgin) curve.
+  double loading(double mu) const {
+    if (mu <= h.mu_crush) return K_e * mu;
+    if (mu <= mu_plock) return h.P_crush + crush_slope() * (mu - h.mu_crush);
+    return dense_of(bar(mu));
+  }
+  /// Unloading modulus after crushing to m (mu_crush < m <= mu_plock), Pa.
+  double unloading_modulus(double m) const {
+    const double F = (m - h.mu_crush) / (mu_plock - h.mu_crush);
+    return (1.0 - F) * K_e + F * h.K1;
+  }
+  /// Pressure at mu after the largest compression mu_max, with damage D (Pa), and dP/dmu of
+  /// the stiffest path open from there (loading or unloading) in `slope`.
+  double pressure(double mu, double mu_max, double D, double& slope) const {
+    const double m = std::max(mu_max, mu);
+    double p;
+    if (m <= h.mu_crush) {
+      p = K_e * mu;
+      slope = K_e;
+    } else if (m <= mu_plock) {
+      const double K_u = unloading_modulus(m);
+      p = loading(m) - K_u * (m - mu);
+      slope = std::max(K_u, crush_slope());
+    } else {
+      p = dense_of(bar(mu));
+      slope = dense_slope_of(bar(mu)) / (1.0 + h.mu_lock);
+    }
+    return std::max(p, -h.T * (1.0 - D));
+  }
+  /// Plastic volumetric strain after crushing to mu_max: where its unloading path has P = 0.
+  double plastic_volumetric_strain(double mu_max) const {
+    if (mu_max <= h.mu_crush) return 0.0;
+    if (mu_max <= mu_plock) return mu_max - loading(mu_max) / unloading_modulus(mu_max);
+    return h.mu_lock;
+  }
+};
+
+/// The pressure of HJC concrete, p = A(rho, mu_max, D) with no energy term (B = 0).
+class HjcEos final : public Eos {
+ public:
+  explicit HjcEos(const MaterialSpec& m) : rho0_(m.density), curve_(m.hjc) {}
+  /// Virgin material (no crushing, no damage): the loading curve.
+  void coefficients(int n, const double* rho, const double* /*e*/, double* A, double* B,
+                    double* K) const override {
+    for (int i = 0; i < n; ++i) set(i, rho[i], 0.0, 0.0, A, B, K);
+  }
+  void block_coefficients(const MaterialBlock& b, const double* /*e*/, double* A, double* B,
+                          double* K) const override {
+    for (int i = 0; i < b.n; ++i)
+      set(i, b.rho[i], b.mu_max ? b.mu_max[i] : 0.0, b.damage ? b.damage[i] : 0.0, A, B, K);
+  }
+
+ private:
+  void set(int i, double rho, double mu_max, double D, double* A, double* B, double* K) const {
+    const double mu = rho / rho0_ - 1.0;
+    double slope;
+    A[i] = curve_.pressure(mu, mu_max, D, slope);
+    B[i] = 0.0;
+    K[i] = (1.0 + mu) * slope;  // rho dP/drho
+  }
+  double rho0_;
+  HjcPressure curve_;
+};
+
+/// HJC strength: sigma_y = f'c sigma*, sigma* = (A (1 - D) + B P*^N)(1 + C ln(rate*)) for
+/// P* = P / f'c >= 0, at most S_max; for P* < 0 linear from A (1 - D) at P* = 0 to zero at the
+/// tension cut-off P* = -T* (1 - D), T* = T / f'c. rate* = max(rate / rate0, 1) with rate the
+/// equivalent deviatoric strain rate. Radial return at the flow stress of the step's start
+/// (pressure at the new density, damage of t^n), then damage D += (d eps_p + d mu_p) / eps_f,
+/// eps_f = max(EF_min, D1 (P* + T*)^D2), D <= 1, with mu_p the plastic volumetric strain of
+/// the crushing (HjcPressure::plastic_volumetric_strain).
+class HjcStrength final : public Strength {
+ public:
+  explicit HjcStrength(const MaterialSpec& m)
+      : h_(m.hjc), rho0_(m.density), T_star_(m.hjc.T / m.hjc.fc), curve_(m.hjc) {}
+
+  bool needs_plastic_strain() const override { return true; }
+  bool needs_pressure() const override { return true; }
+
+  /// Normalised strength sigma* at P*, damage D and equivalent strain rate (1/s).
+  double normalised(double P_star, double D, double rate) const {
+    const double R =
+        rate > h_.reference_rate ? 1.0 + h_.C * std::log(rate / h_.reference_rate) : 1.0;
+    const double s = P_star >= 0 ? h_.A * (1.0 - D) + h_.B * std::pow(P_star, h_.N)
+                                 : std::max(0.0, h_.A * ((1.0 - D) + P_star / T_star_));
+    return std::min(s * R, h_.S_max);
+  }
+  /// Fracture strain at P*: max(EF_min, D1 (P* + T*)^D2).
+  double fracture_strain(double P_star) const {
+    return std::max(h_.EF_min, h_.D1 * std::pow(std::max(P_star + T_star_, 0.0), h_.D2));
+  }
+  /// The intact strength at zero pressure (the implicit solver's tangent asks; HJC runs
+  /// explicit only).
+  double flow_stress(double, double rate, double) const override {
+    return h_.fc * normalised(0.0, 0.0, rate);
+  }
+
+  void update(MaterialBlock& b, BlockScratch& S, double G) const override {
+    for (int i = 0; i < b.n; ++i) {
+      const double P_star = S.p[i] / h_.fc;
+      double D = b.damage ? b.damage[i] : 0.0;
+      const Sym s_tr = S.s[i] + 2.0 * G * S.de[i];  // elastic predictor
+      const double q_tr = std::sqrt(1.5 * ddot(s_tr, s_tr));
+      const double rate = std::sqrt(2.0 / 3.0 * ddot(S.de[i], S.de[i])) / b.dt;
+      const double sy = h_.fc * normalised(P_star, D, rate);
+      double dl = 0.0;
+      if (q_tr > sy) {
+        dl = (q_tr - sy) / (3.0 * G);
+        S.s[i] = s_tr * (sy / q_tr);  // radial return
+        b.eps_p[i] += dl;
+      } else {
+        S.s[i] = s_tr;
+      }
+      S.dlambda[i] = dl;
+      S.yield[i] = sy;
+      // Crushing: the growth of the plastic volumetric strain as mu_max grows.
+      double dmu_p = 0.0;
+      if (b.mu_max) {
+        const double mu = b.rho[i] / rho0_ - 1.0, m_old = b.mu_max[i];
+        if (mu > m_old) {
+          dmu_p = std::max(
+              0.0, curve_.plastic_volumetric_strain(mu) - curve_.plastic_volumetric_strain(m_old));
+          b.mu_max[i] = mu;
+        }
+      }
+      if (b.damage && dl + dmu_p > 0) {
+        D += (dl + dmu_p) / fracture_strain(P_star);
+        b.damage[i] = std::min(D, 1.0);
+      }
+    }
+  }
+
+ private:
+  HjcSpec h_;
+  double rho0_, T_star_;
+  HjcPressure curve_;
+};
+
+}  // namespace
+
+std::unique_ptr<Strength> make_hjc_strength(const MaterialSpec& m) {
+  return std::make_unique<HjcStrength>(m);
+}
+std::unique_ptr<Eos> make_hjc_eos(const MaterialSpec& m) {
+  return std::make_unique<HjcEos>(m);
+}
+
+}  // namespace mpm
