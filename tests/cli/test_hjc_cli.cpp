@@ -132,8 +132,10 @@ TEST(HjcCli, BadHjcInputExitsTwo) {
   ASSERT_EQ(run(prep + " " + write(dir, "good.toml", kCube).string() + " -o " + good.string(), dir)
                 .status,
             0);
-  const Result r = run(
-      runner + " good.mpm --progress none --set materials.concrete.strength.fc=-1 -o r.mpm", dir);
+  const Result r = run(runner + " " + good.string() +
+                           " --progress none --set materials.concrete.strength.fc=-1 -o " +
+                           (dir / "r.mpm").string(),
+                       dir);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("materials.concrete.strength.fc: must be > 0"), std::string::npos) << r.err;
 }
