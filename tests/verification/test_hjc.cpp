@@ -71,7 +71,7 @@ z_min = "slip"
 end_time = "160 us"
 )";
 
-TEST(Hjc, SceneKeysGiveThePublishedConstants) {
+TEST(HjcRun, SceneKeysGiveThePublishedConstants) {
   const Scene s = parse_scene(kCube, "cube.toml", "", {});
   const MaterialSpec& m = s.materials.at(0);
   EXPECT_EQ(m.strength.model, StrengthModel::Hjc);
@@ -95,7 +95,7 @@ TEST(Hjc, SceneKeysGiveThePublishedConstants) {
 // 2.06 f'c: with Table 4's A, B and N the unconfined strength is A + B (1/3)^N = 1.61 f'c
 // even without damage at P* = 1/3, and 2.06 f'c where sigma* and P* agree; the model as
 // published. After the peak the damage from plastic strain softens the cube.
-TEST(Hjc, CubeInUnconfinedCompressionPeaksAtTheModelsStrength) {
+TEST(HjcRun, CubeInUnconfinedCompressionPeaksAtTheModelsStrength) {
   const Scene scene = parse_scene(kCube, "cube.toml", "", {});
   const Lattice lat = make_lattice(scene);
   std::vector<BodyReport> report;
@@ -123,6 +123,8 @@ TEST(Hjc, CubeInUnconfinedCompressionPeaksAtTheModelsStrength) {
   omp_set_num_threads(threads);
   // The peak within 4% of 99.1 MPa: the rate term is uncertain by 0.3% (38 to 50 /s), the
   // stress ringing from the discrete start and the particles' own noise by a few percent.
+  // Measured: 100.7 MPa at a strain of 0.0036 (100.6 MPa on 2 mm cells); without the
+  // crushing's damage the fixed point would be 101.8 MPa, without the rate term 95.4 MPa.
   std::printf("HJC cube: %ld steps, peak %.4g MPa at strain %.4g, end %.4g MPa, D_max %.3f\n",
               long(solver.steps()), peak / 1e6, strain_at_peak, last / 1e6, D_max);
   EXPECT_NEAR(peak, 99.1e6, 0.04 * 99.1e6) << "strain at the peak " << strain_at_peak;
@@ -149,7 +151,7 @@ std::string replaced(std::string s, const std::string& from, const std::string& 
   return s.replace(at, from.size(), to);
 }
 
-TEST(Hjc, BadInputNamesFileLineAndKey) {
+TEST(HjcRun, BadInputNamesFileLineAndKey) {
   struct Case {
     std::string from, to, says;
   };
