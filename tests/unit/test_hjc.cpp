@@ -188,6 +188,60 @@ TEST(Hjc, DamageIncrementFromCrushing) {
   EXPECT_EQ(u.mu_max, 0.05);
 }
 
+/// One HJC point with its whole state, updated through Material::update.
+struct Point {
+  Sym sigma = Sym::Zero();
+  double rho = 2440, e = 0, eps_p = 0, D = 0, mu_max = 0, m = 1e-6, c = 0, thickness = 1;
+  void update(const Material& mat, const Mat3& L, double dt, bool plane_stress) {
+    static BlockScratch S;
+    MaterialBlock b;
+    b.n = 1;
+    b.dt = dt;
+    b.h = 1e-3;
+    b.L = &L;
+    b.m = &m;
+    b.sigma = &sigma;
+    b.rho = &rho;
+    b.e = &e;
+    b.eps_p = &eps_p;
+    b.damage = &D;
+    b.mu_max = &mu_max;
+    b.c = &c;
+    b.plane_stress = plane_stress;
+    b.thickness = plane_stress ? &thickness : nullptr;
+    mat.update(b, S);
+  }
+};
+
+// Plane stress repeats the whole update from the state of t^n until sigma_zz = 0, so the HJC
+// history (damage, mu_max) must be restored before each pass: the converged plane-stress
+// update then equals the 3D update at the rate it found, L_zz = (thickness ratio - 1) / dt.
+// Compressed in x (strain 0.001 a step, y held) for 30 steps, the sheet crushes, yields and
+// damages; a pass that kept the history of the one before would add the damage of every pass
+// (several per step). Tolerance: L_zz recovered from the thickness carries round-off of 1e-16
+// / dt, which moves the stresses by ~1e-9 of their size.
+TEST(Hjc, PlaneStressIterationRestoresTheHistory) {
+  SolverSpec no_viscosity;
+  no_viscosity.bulk_linear = no_viscosity.bulk_quadratic = 0;
+  const Material mat(concrete(), no_viscosity);
+  Point sheet, solid;
+  const double dt = 1e-7;
+  for (int step = 0; step < 30; ++step) {
+    Mat3 L = Mat3::Zero();
+    L(0, 0) = -0.001 / dt;
+    const double t0 = sheet.thickness;
+    sheet.update(mat, L, dt, true);
+    L(2, 2) = (sheet.thickness / t0 - 1.0) / dt;
+    solid.update(mat, L, dt, false);
+    EXPECT_NEAR(sheet.D, solid.D, 1e-9) << "step " << step;
+    EXPECT_NEAR(sheet.mu_max, solid.mu_max, 1e-12) << "step " << step;
+    EXPECT_NEAR(sheet.sigma[0], solid.sigma[0], 1e-7 * 1e8) << "step " << step;
+  }
+  EXPECT_LT(std::abs(sheet.sigma[2]), 1e-6 * std::abs(sheet.sigma[0]));  // plane stress held
+  EXPECT_GT(sheet.D, 0.05);                                              // it did damage
+  EXPECT_GT(sheet.mu_max, 0.001);                                        // and crush
+}
+
 TEST(Hjc, ColumnsOnlyWhenUsed) {
   Scene s;
   s.materials.push_back(concrete());
