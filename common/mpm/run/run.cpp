@@ -71,6 +71,7 @@ extern "C" void on_signal(int sig) {
 struct Model {
   std::string scene_text;
   Frame frame;
+  Frame rebar;  ///< the REBR record: the rebar's elements (no columns without rebar)
 };
 
 /// Refuses, before the particles are read, a model whose run would need more than `limit`
@@ -129,6 +130,9 @@ Model read_model(const RunOptions& opt) {
   };
   v.frame = [&](Frame&& f) {
     if (!have_frame) model.frame = std::move(f), have_frame = true;
+  };
+  v.rebar = [&](Frame&& f) {
+    if (model.rebar.columns.columns().empty()) model.rebar = std::move(f);
   };
   const StreamSummary s = read_stream(path, v);
   const std::string name = path == "-" ? "stdin" : path;
@@ -244,12 +248,13 @@ class TimeLoop {
 
  public:
   TimeLoop(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Solver& solver,
-           const Restart* restart)
+           const Restart* restart, ColumnStore* rebar)
       : opt_(opt),
         o_(scene.output),
         end_(scene.solver.end_time),
         solver_(solver),
         restart_(restart),
+        rebar_(rebar),
         history_(Solver::D, scene, kImplicit),
         extremes_(scene),
         checkpoint_(scene.output, solver.time()),
@@ -261,7 +266,8 @@ class TimeLoop {
       next_history_ = s.get("next_history");
       checkpoint_.restore(s);
     } else {
-      out_ = std::make_unique<StreamWriter>(opt.output);
+      out_ = std::make_unique<StreamWriter>(opt.output,
+                                            rebar ? kStreamVersionMinor : kStreamMinorWithoutRebar);
       out_->write_text(RecordType::Scene, scene.toml);
       out_->write_text(RecordType::Info, run_info(scene, lattice, omp_get_max_threads()));
       next_history_ = o_.history_interval;
@@ -303,6 +309,15 @@ class TimeLoop {
     write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
     emit_grid();
     write_particles(flags, [&](const Frame& f) { out_->write_frame(f, o_.fields, o_.precision); });
+    if (rebar_) {  // the elements' state at the frame (a REBR record after it)
+      Frame e;
+      e.step = solver_.steps();
+      e.time = solver_.time();
+      e.flags = flags;
+      std::swap(e.columns, *rebar_);
+      out_->write_rebar(e);
+      std::swap(e.columns, *rebar_);
+    }
     extremes_.sample(solver_.particles(), solver_.time());
   }
   /// A CHKP record: the particles in cell order (settle) with the state the columns do not
@@ -326,14 +341,15 @@ class TimeLoop {
   /// particles are due for a re-sort (at most kSignalWait steps on), after a checkpoint.
   bool stop_for_signal() {
     if (!g_signal) return false;
-    if constexpr (kCheckpoints<Solver>) {
+    const bool checkpoint = kCheckpoints<Solver> && !rebar_;  // rebar: no checkpoints yet
+    if (checkpoint) {
       if (!solver_.sort_pending() && ++signal_wait_ <= kSignalWait) return false;
       write_checkpoint();
     }
     status_ = 128 + g_signal;
     message_ = "interrupted by signal " + std::to_string(int(g_signal)) +
                " at t = " + std::to_string(solver_.time()) + " s; the last frame is the state then";
-    if constexpr (kCheckpoints<Solver>)
+    if (checkpoint)
       message_ += opt_.output == "-"
                       ? "; the stream holds a checkpoint of it: saved to a file, it continues "
                         "with mpm-run --restart FILE"
@@ -349,6 +365,7 @@ class TimeLoop {
   const double end_;
   Solver& solver_;
   const Restart* restart_;
+  ColumnStore* rebar_;  ///< the rebar's element table, or null
   std::unique_ptr<StreamWriter> out_;
   History history_;
   MaterialExtremes extremes_;  ///< sampled at each frame, reported at the end
@@ -451,7 +468,14 @@ void TimeLoop<Solver>::report(double loop_wall) const {
 
 template <class Solver>
 int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Solver& solver,
-               const Restart* restart) {
+               const Restart* restart, ColumnStore* rebar = nullptr) {
+  if (rebar) {
+    if (scene.output.checkpoint_time > 0 || scene.output.checkpoint_wall > 0)
+      throw InputError("output.checkpoint",
+                       "runs with rebar do not write checkpoints (the elements' state is not "
+                       "saved in them yet); remove output.checkpoint");
+    if constexpr (requires { solver.attach_rebar(*rebar); }) solver.attach_rebar(*rebar);
+  }
   if constexpr (kCheckpoints<Solver>) {
     if (restart) solver.restore_state(restart->checkpoint.state);
   } else if (scene.output.checkpoint_time > 0 || scene.output.checkpoint_wall > 0) {
@@ -462,13 +486,13 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
                          : "graded grids do not write checkpoints (the window of their levels is "
                            "not saved yet); remove output.checkpoint");
   }
-  TimeLoop<Solver> loop(opt, scene, lattice, solver, restart);
+  TimeLoop<Solver> loop(opt, scene, lattice, solver, restart, rebar);
   return loop();
 }
 
 template <int D>
 int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame& model,
-        const Restart* restart) {
+        const Restart* restart, ColumnStore* rebar = nullptr) {
   const bool graded = !scene.grid.levels.empty();  // mesh grading (004, section 3)
   if (scene.solver.type == SolverType::Implicit) {
     if (graded)
@@ -496,7 +520,7 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
                        "[[grid.levels]] (use colored, lr-slabs or array-expansion)");
     ExplicitSolver<GradedGrid<D>> solver(scene, GradedGrid<D>(lattice, scene), model.columns,
                                          strategy);
-    return run_solver(opt, scene, lattice, solver, restart);
+    return run_solver(opt, scene, lattice, solver, restart, rebar);
   }
   if (scene.grid.sparse) {
     if (strategy == ScatterStrategy::Patch)
@@ -506,10 +530,10 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
                        "array-expansion");
     ExplicitSolver<SparseGrid<D>> solver(scene, SparseGrid<D>(lattice, scene.boundary),
                                          model.columns, strategy);
-    return run_solver(opt, scene, lattice, solver, restart);
+    return run_solver(opt, scene, lattice, solver, restart, rebar);
   }
   UniformSolver<D> solver(scene, UniformGrid<D>(lattice, scene.boundary), model.columns, strategy);
-  return run_solver(opt, scene, lattice, solver, restart);
+  return run_solver(opt, scene, lattice, solver, restart, rebar);
 }
 
 /// mpm-run --restart: the run of a result stream continued from its last intact checkpoint.
@@ -525,10 +549,12 @@ int restart_model(const RunOptions& opt) {
     throw InputError("--restart " + opt.restart,
                      "runs of the implicit solver cannot be continued: its checkpoints are not "
                      "written yet; run the model again");
-  if (!scene.grid.levels.empty())
-    throw InputError("--restart " + opt.restart,
-                     "runs on graded grids cannot be continued: their checkpoints are not "
-                     "written yet; run the model again");
+  if (!scene.grid.levels.empty() || !scene.rebars.empty())
+    throw InputError(
+        "--restart " + opt.restart,
+        std::string(scene.rebars.empty() ? "runs on graded grids" : "runs with rebar") +
+            " cannot be continued: their checkpoints are not written yet; run the "
+            "model again");
   check_restartable(opt.restart, restart.scan);
   restart.checkpoint = load_checkpoint(opt.restart, restart.scan);
   const RestartScan& s = restart.scan;
@@ -561,8 +587,15 @@ int run_model(const RunOptions& opt) {
   const std::string name = (opt.input == "-" ? std::string("stdin") : opt.input) + " (scene)";
   const Scene scene = parse_scene(model.scene_text, name, "", opt.overrides);
   const Lattice lattice = make_lattice(scene);
-  if (scene.dimension == 3) return run<3>(opt, scene, lattice, model.frame, nullptr);
-  return run<2>(opt, scene, lattice, model.frame, nullptr);
+  const bool has_rebar = !model.rebar.columns.columns().empty();
+  if (has_rebar != !scene.rebars.empty())
+    throw InputError(name, has_rebar ? "the model holds rebar elements (REBR) but its scene no "
+                                       "[[rebar]]"
+                                     : "the scene has [[rebar]] but the model holds no rebar "
+                                       "elements (REBR): make it again with this mpm-prep");
+  ColumnStore* rebar = has_rebar ? &model.rebar.columns : nullptr;
+  if (scene.dimension == 3) return run<3>(opt, scene, lattice, model.frame, nullptr, rebar);
+  return run<2>(opt, scene, lattice, model.frame, nullptr, rebar);
 }
 
 }  // namespace mpm
