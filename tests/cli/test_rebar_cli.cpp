@@ -15,6 +15,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "mpm/stream/stream.hpp"
 #include "run_command.hpp"
 
 namespace mpm {
@@ -163,6 +164,49 @@ TEST(RebarCli, ModelsWithoutRebarStayStreams14) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(int(slurp(dir / "a.mpm")[10]), 4);
   EXPECT_EQ(int(slurp(dir / "b.mpm")[10]), 5);
+}
+
+/// The FRAM and REBR records of an intact stream, as bytes, and where its first CHKP ends.
+std::vector<std::string> frames_and_rebar(const fs::path& p, std::uint64_t* first_checkpoint_end) {
+  std::vector<std::string> out;
+  const std::string bytes = slurp(p);
+  StreamReader r(p.string());
+  std::uint32_t type = 0;
+  while (r.next(type)) {
+    const std::uint64_t begin = r.record_offset();
+    r.skip();
+    if (type == std::uint32_t(RecordType::Frame) || type == std::uint32_t(RecordType::Rebar))
+      out.push_back(bytes.substr(begin, r.offset() - begin));
+    if (type == std::uint32_t(RecordType::Checkpoint) && first_checkpoint_end &&
+        *first_checkpoint_end == 0)
+      *first_checkpoint_end = r.offset();
+  }
+  return out;
+}
+
+TEST(RebarCli, RestartFromACheckpointContinuesBitwise) {
+  // The slab on a uniform grid with a checkpoint every 10 us: the stream cut after the first
+  // one and continued with --restart holds bitwise the frames and rebar of the whole run.
+  const auto dir = temp_dir("rebar_restart");
+  std::string scene = slurp(kSlab);
+  scene.erase(scene.find("[[grid.levels]]"),
+              scene.find("[solver]") - scene.find("[[grid.levels]]"));
+  scene += "checkpoint = { time = \"10 us\" }\n";
+  std::ofstream(dir / "uniform.toml") << scene;
+  const fs::path full = dir / "full.mpm", cut = dir / "cut.mpm";
+  Result r = prep_and_run(dir / "uniform.toml", "", full, dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::uint64_t keep = 0;
+  const std::vector<std::string> whole = frames_and_rebar(full, &keep);
+  ASSERT_GT(keep, 0u) << "no checkpoint";
+  ASSERT_EQ(whole.size(), 2u * 4 + 2);  // 4 frames and their REBR; a REBR before each CHKP
+  std::ofstream(cut, std::ios::binary) << slurp(full).substr(0, keep);
+  r = run(runner + " --restart " + cut.string() + " --progress none", dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::vector<std::string> again = frames_and_rebar(cut, nullptr);
+  ASSERT_EQ(again.size(), whole.size());
+  for (std::size_t k = 0; k < whole.size(); ++k)
+    EXPECT_TRUE(again[k] == whole[k]) << "record " << k;
 }
 
 }  // namespace

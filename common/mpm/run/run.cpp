@@ -224,6 +224,7 @@ void print_stats(Solver& solver, int threads, double loop_wall) {
 struct Restart {
   RestartScan scan;
   Checkpoint checkpoint;
+  Frame rebar;  ///< the rebar's elements at the checkpoint (the REBR record before it)
 };
 
 /// True for a solver whose state a checkpoint holds: the explicit solver on a uniform or
@@ -309,16 +310,23 @@ class TimeLoop {
     write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
     emit_grid();
     write_particles(flags, [&](const Frame& f) { out_->write_frame(f, o_.fields, o_.precision); });
-    if (rebar_) {  // the elements' state at the frame (a REBR record after it)
-      Frame e;
-      e.step = solver_.steps();
-      e.time = solver_.time();
-      e.flags = flags;
-      std::swap(e.columns, *rebar_);
-      out_->write_rebar(e);
-      std::swap(e.columns, *rebar_);
-    }
+    if (rebar_) write_rebar(flags);  // the elements' state at the frame (after it)
     extremes_.sample(solver_.particles(), solver_.time());
+  }
+  /// A REBR record: the rebar's elements now, written without copying them.
+  void write_rebar(std::uint32_t flags) {
+    Frame e;
+    e.step = solver_.steps();
+    e.time = solver_.time();
+    e.flags = flags;
+    std::swap(e.columns, *rebar_);
+    try {
+      out_->write_rebar(e);
+    } catch (...) {
+      std::swap(e.columns, *rebar_);
+      throw;
+    }
+    std::swap(e.columns, *rebar_);
   }
   /// A CHKP record: the particles in cell order (settle) with the state the columns do not
   /// hold; the history rows before it are flushed first, so the stream up to it is complete.
@@ -333,6 +341,7 @@ class TimeLoop {
       s.set("frame", frame_);
       s.set("next_history", next_history_);
       checkpoint_.save(s);
+      if (rebar_) write_rebar(0);  // the elements' state, before the checkpoint it goes with
       write_particles(0, [&](const Frame& f) { out_->write_checkpoint(s, f); });
       checkpoint_.written();
     }
@@ -341,7 +350,7 @@ class TimeLoop {
   /// particles are due for a re-sort (at most kSignalWait steps on), after a checkpoint.
   bool stop_for_signal() {
     if (!g_signal) return false;
-    const bool checkpoint = kCheckpoints<Solver> && !rebar_;  // rebar: no checkpoints yet
+    constexpr bool checkpoint = kCheckpoints<Solver>;
     if (checkpoint) {
       if (!solver_.sort_pending() && ++signal_wait_ <= kSignalWait) return false;
       write_checkpoint();
@@ -469,13 +478,8 @@ void TimeLoop<Solver>::report(double loop_wall) const {
 template <class Solver>
 int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Solver& solver,
                const Restart* restart, ColumnStore* rebar = nullptr) {
-  if (rebar) {
-    if (scene.output.checkpoint_time > 0 || scene.output.checkpoint_wall > 0)
-      throw InputError("output.checkpoint",
-                       "runs with rebar do not write checkpoints (the elements' state is not "
-                       "saved in them yet); remove output.checkpoint");
-    if constexpr (requires { solver.attach_rebar(*rebar); }) solver.attach_rebar(*rebar);
-  }
+  if constexpr (requires { solver.attach_rebar(*rebar); })
+    if (rebar) solver.attach_rebar(*rebar);
   if constexpr (kCheckpoints<Solver>) {
     if (restart) solver.restore_state(restart->checkpoint.state);
   } else if (scene.output.checkpoint_time > 0 || scene.output.checkpoint_wall > 0) {
@@ -549,14 +553,18 @@ int restart_model(const RunOptions& opt) {
     throw InputError("--restart " + opt.restart,
                      "runs of the implicit solver cannot be continued: its checkpoints are not "
                      "written yet; run the model again");
-  if (!scene.grid.levels.empty() || !scene.rebars.empty())
-    throw InputError(
-        "--restart " + opt.restart,
-        std::string(scene.rebars.empty() ? "runs on graded grids" : "runs with rebar") +
-            " cannot be continued: their checkpoints are not written yet; run the "
-            "model again");
+  if (!scene.grid.levels.empty())
+    throw InputError("--restart " + opt.restart,
+                     "runs on graded grids cannot be continued: their checkpoints are not "
+                     "written yet; run the model again");
   check_restartable(opt.restart, restart.scan);
-  restart.checkpoint = load_checkpoint(opt.restart, restart.scan);
+  restart.checkpoint = load_checkpoint(opt.restart, restart.scan, &restart.rebar);
+  ColumnStore* rebar = nullptr;
+  if (!scene.rebars.empty()) {
+    if (restart.rebar.columns.columns().empty())
+      throw StreamError(opt.restart, "its checkpoint has no rebar elements (REBR) before it");
+    rebar = &restart.rebar.columns;
+  }
   const RestartScan& s = restart.scan;
   std::fprintf(stderr,
                "mpm-run: continuing %s from its checkpoint at step %ld, t = %g s; the %zu "
@@ -569,8 +577,8 @@ int restart_model(const RunOptions& opt) {
                                  : "cut at a record boundary");
   const Lattice lattice = make_lattice(scene);
   Frame& particles = restart.checkpoint.frame;
-  if (scene.dimension == 3) return run<3>(opt, scene, lattice, particles, &restart);
-  return run<2>(opt, scene, lattice, particles, &restart);
+  if (scene.dimension == 3) return run<3>(opt, scene, lattice, particles, &restart, rebar);
+  return run<2>(opt, scene, lattice, particles, &restart, rebar);
 }
 
 }  // namespace

@@ -166,8 +166,9 @@ class ExplicitSolver : public SolverCore<GridT> {
                     ChunkSums& s) const;
   /// A particle without stress in the stress pass: a rigid one advances with its own
   /// velocity, a rebar node with the grid's (v_c: its bin's cached nodal velocities or null).
-  void move_unstressed(const ParticleView<D>& p, std::uint32_t i, std::int64_t bin_key,
-                       const std::int64_t* nodes, int nn, const Vec<D>* v_c, ChunkSums& s);
+  [[gnu::noinline, gnu::cold]] void move_unstressed(const ParticleView<D>& p, std::uint32_t i,
+                                                    std::int64_t bin_key, const std::int64_t* nodes,
+                                                    int nn, const Vec<D>* v_c, ChunkSums& s);
   template <bool C>
   void stress_chunk(const ParticleView<D>& p, int ch, const Vec<D>* vg_i, Positions positions,
                     bool remapped, ChunkSums& s);

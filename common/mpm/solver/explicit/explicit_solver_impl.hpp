@@ -113,6 +113,7 @@ void ExplicitSolver<GridT>::save_state(StateValues& s) const {
   s.set("next_id", double(next_id_));
   s.set("splits", double(split_count_));
   s.set("split_wait", double(split_wait_));
+  if (rebar_.active()) s.set("rebar_energy", rebar_sums_.energy);  // in the balance's internal
 }
 
 template <Grid GridT>
@@ -123,6 +124,7 @@ void ExplicitSolver<GridT>::restore_state(const StateValues& s) {
   next_id_ = std::uint32_t(s.get("next_id"));
   split_count_ = long(s.get("splits"));
   split_wait_ = int(s.get("split_wait"));
+  if (rebar_.active()) rebar_sums_.energy = s.get("rebar_energy");
 }
 
 template <Grid GridT>
