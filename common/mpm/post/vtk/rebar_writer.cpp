@@ -37,7 +37,8 @@ RebarLines rebar_lines(const Frame& particles, const Frame& elements) {
   const auto* xs = reinterpret_cast<const double*>(x->data());
   const auto* ends = reinterpret_cast<const std::uint32_t*>(nodes->data());
   std::unordered_map<std::uint32_t, std::uint32_t> point_of;  // node id -> point
-  for (std::size_t k = 0; k < 2 * elements.columns.size(); ++k) point_of.emplace(ends[k], 0);
+  constexpr std::uint32_t kAbsent = ~0u;
+  for (std::size_t k = 0; k < 2 * elements.columns.size(); ++k) point_of.emplace(ends[k], kAbsent);
   for (std::size_t i = 0; i < particles.columns.size(); ++i) {
     auto it = point_of.find(ids[i]);
     if (it == point_of.end()) continue;
@@ -55,7 +56,7 @@ RebarLines rebar_lines(const Frame& particles, const Frame& elements) {
   };
   for (std::size_t e = 0; e < elements.columns.size(); ++e) {
     const auto a = point_of.find(ends[2 * e]), b = point_of.find(ends[2 * e + 1]);
-    if (a == point_of.end() || b == point_of.end() || r.points.empty()) continue;
+    if (a->second == kAbsent || b->second == kAbsent) continue;  // a node not in the frame
     r.lines.push_back({a->second, b->second});
     r.sigma.push_back(value(rebar_col::sigma, e));
     r.eps_p.push_back(value(rebar_col::eps_pbar, e));
@@ -102,16 +103,26 @@ void write_rebar_vtu(const RebarLines& r, double time, std::int64_t step, const 
 
 namespace mpm::vtk_internal {
 
-vtkSmartPointer<vtkActor> rebar_actor(const RebarLines& r) {
+vtkSmartPointer<vtkActor> rebar_actor(const RebarLines& r, const Symmetry& symmetry,
+                                      const Section& section, bool keep_greater) {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
-  for (const Vec3& p : r.points) points->InsertNextPoint(p.data());
+  const int images = symmetry.images();
+  for (int k = 0; k < images; ++k)  // image k of point j is point k n + j
+    for (const Vec3& p : r.points) points->InsertNextPoint(symmetry.point_image(p, k).data());
+  auto kept = [&](vtkIdType id) {  // on the side of the section the picture keeps
+    if (section.axis < 0) return true;
+    const double c = points->GetPoint(id)[section.axis];
+    return keep_greater ? c >= section.position : c <= section.position;
+  };
   vtkNew<vtkCellArray> lines;
-  for (std::size_t e = 0; e < r.lines.size(); ++e) {
-    if (r.eroded[e]) continue;  // removed: a gap in the bar
-    const vtkIdType ids[2] = {vtkIdType(r.lines[e][0]), vtkIdType(r.lines[e][1])};
-    lines->InsertNextCell(2, ids);
-  }
+  const vtkIdType n = vtkIdType(r.points.size());
+  for (int k = 0; k < images; ++k)
+    for (std::size_t e = 0; e < r.lines.size(); ++e) {
+      if (r.eroded[e]) continue;  // removed: a gap in the bar
+      const vtkIdType ids[2] = {k * n + vtkIdType(r.lines[e][0]), k * n + vtkIdType(r.lines[e][1])};
+      if (kept(ids[0]) && kept(ids[1])) lines->InsertNextCell(2, ids);
+    }
   vtkNew<vtkPolyData> poly;
   poly->SetPoints(points);
   poly->SetLines(lines);

@@ -463,7 +463,7 @@ void render_png(const Frame& frame, int dim, const RenderOptions& options,
     bars->SetLayer(2);
     bars->SetViewport(scene_vp[0], scene_vp[1], scene_vp[2], scene_vp[3]);
     bars->SetActiveCamera(scene->GetActiveCamera());
-    bars->AddActor(rebar_actor(options.rebar));
+    bars->AddActor(rebar_actor(options.rebar, options.symmetry, section, drawn.keep_greater));
     bars->InteractiveOff();
     window->AddRenderer(bars);
   }

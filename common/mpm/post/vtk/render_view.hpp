@@ -18,9 +18,12 @@
 
 namespace mpm::vtk_internal {
 
-/// Rebar as red lines, its eroded elements left out (rebar_writer.cpp): drawn over the
-/// particles, in a layer of its own, so that bars inside the material show.
-vtkSmartPointer<vtkActor> rebar_actor(const RebarLines& rebar);
+struct Section;
+/// Rebar as red lines, its eroded elements left out (rebar_writer.cpp), with its images in the
+/// symmetry's planes and on the kept side of a section: drawn over the particles, in a layer
+/// of its own, so that bars inside the material show.
+vtkSmartPointer<vtkActor> rebar_actor(const RebarLines& rebar, const Symmetry& symmetry,
+                                      const Section& section, bool keep_greater);
 
 /// A section plane x_axis = position; the picture keeps one side and looks square at the cut.
 struct Section {
