@@ -162,6 +162,49 @@ element_length = "4 mm"
   EXPECT_NEAR(x[0].y(), 0.0125, 1e-15);
 }
 
+TEST(RebarScene, BarsOnSymmetryPlanesCarryTheirShare) {
+  // A quarter model (slip faces x = 0 and y = 0 are mirror planes): a bar lying in one plane
+  // is half a bar of the whole model, one on both planes (their intersection) a quarter; a bar
+  // off the planes is whole.
+  const Scene s = scene_with(R"(
+[boundary]
+x_min = "slip"
+y_min = "slip"
+[[rebar]]
+shape = "bar"
+material = "steel"
+diameter = "6 mm"
+start = "0 10 5 mm"
+end = "0 50 5 mm"
+[[rebar]]
+shape = "bar"
+material = "steel"
+diameter = "6 mm"
+start = "0 0 5 mm"
+end = "0 0 25 mm"
+[[rebar]]
+shape = "bar"
+material = "steel"
+diameter = "6 mm"
+start = "10 10 5 mm"
+end = "10 50 5 mm"
+)");
+  Lattice lat = slab_lattice();
+  lat.origin = Vec3(0, 0, -0.01);
+  ColumnStore cols = model_columns();
+  std::vector<RebarReport> rep;
+  const ColumnStore el =
+      discretise_rebar(s, lat, {Vec3::Zero()}, {Vec3(0.1, 0.1, 0.04)}, cols, rep);
+  const double A = 0.25 * kPi * 36e-6;
+  EXPECT_NEAR(rep[0].exact_mass / (7500 * A * 0.04), 0.5, 1e-12);
+  EXPECT_NEAR(rep[1].exact_mass / (7500 * A * 0.02), 0.25, 1e-12);
+  EXPECT_NEAR(rep[2].exact_mass / (7500 * A * 0.04), 1.0, 1e-12);
+  for (const auto& r : rep) EXPECT_NEAR(r.mass / r.exact_mass, 1.0, 1e-12);
+  const double* area = el.get<double>(rebar_col::area);
+  EXPECT_DOUBLE_EQ(area[0], 0.5 * A);
+  EXPECT_DOUBLE_EQ(area[el.size() - 1], A);
+}
+
 TEST(RebarScene, OutsideTheDomainAndBadPolylinesAreRefused) {
   Scene s = scene_with(R"(
 [[rebar]]

@@ -106,6 +106,22 @@ void check_in_domain(const RebarSpec& b, const Lattice& lattice, const Vec3& x,
                format_mm(lo[2]) + ", " + format_mm(hi[2]) + "] mm");
 }
 
+/// The share of a bar's section in the model: a half for each symmetry plane (a slip face of
+/// the domain) the whole bar lies in, so that a quarter model's bar on a mirror plane carries
+/// half its steel, as its particles there carry half their cell.
+double section_share(const std::vector<Vec3>& line, const Scene& scene, const Lattice& lattice) {
+  double share = 1;
+  for (int f = 0; f < 6; ++f) {
+    if (scene.boundary.face[f] != BoundaryType::Slip) continue;
+    const int a = f / 2;
+    const double plane = f % 2 ? lattice.max()[a] : lattice.origin[a];
+    bool on = true;
+    for (const Vec3& x : line) on = on && std::abs(x[a] - plane) <= 1e-9 * lattice.h;
+    if (on) share *= 0.5;
+  }
+  return share;
+}
+
 /// Node particles appended to the model's columns.
 struct NodeSink {
   ColumnStore& cols;
@@ -154,7 +170,7 @@ ColumnStore discretise_rebar(const Scene& scene, const Lattice& lattice,
   for (std::size_t r = 0; r < scene.rebars.size(); ++r) {
     const RebarSpec& b = scene.rebars[r];
     const MaterialSpec& mat = scene.materials[b.material];
-    const double A = 0.25 * kPi * b.diameter * b.diameter, rho = mat.density;
+    const double A_bar = 0.25 * kPi * b.diameter * b.diameter, rho = mat.density;
     const double le = b.element_length > 0 ? b.element_length : 0.5 * lattice.h;
     const Vec3 vel = scene.bodies[b.body].velocity;
     RebarReport& rep = report[r];
@@ -169,6 +185,7 @@ ColumnStore discretise_rebar(const Scene& scene, const Lattice& lattice,
         if (s > 0) total += (line[s] - line[s - 1]).norm();
       }
       if (!(total > 0)) fail(b, key, "a bar of zero length");
+      const double A = A_bar * section_share(line, scene, lattice);
       std::uint32_t prev = nodes.add(line[0], b.body, vel, rho, first_id);
       for (std::size_t s = 0; s + 1 < line.size(); ++s) {
         const Vec3 a = line[s], e = line[s + 1];
@@ -192,8 +209,8 @@ ColumnStore discretise_rebar(const Scene& scene, const Lattice& lattice,
           prev = next;
         }
         rep.length += L;
+        rep.exact_mass += rho * A * L;
       }
-      rep.exact_mass = rho * A * rep.length;
     }
   }
   // The node particles, after the model's.

@@ -16,7 +16,7 @@ struct RebarReport {
   std::size_t bars = 0, elements = 0, nodes = 0;
   double length = 0;          ///< m, all its bars
   double mass = 0;            ///< kg, the sum of its nodes' lumped masses
-  double exact_mass = 0;      ///< kg, rho A L_total
+  double exact_mass = 0;      ///< kg, rho A L_total (A halved on a symmetry plane)
   double element_length = 0;  ///< m, the longest element
   double shortest = 0;        ///< m, the shortest element
 };
