@@ -115,6 +115,28 @@ count = [4, 4]
   EXPECT_NE(e.find("rebar.0: missing required key 'body'"), std::string::npos) << e;
 }
 
+TEST(RebarScene, OverridesSelectAnEntryByIndex) {
+  const std::string bar = R"(
+[[rebar]]
+shape = "bar"
+material = "steel"
+diameter = "6 mm"
+start = "5 50 30 mm"
+end = "95 50 30 mm"
+)";
+  const Scene s = parse_scene(kHead + bar, "s.toml", "",
+                              {"rebar.0.diameter=4mm", "rebar.0.erosion_strain=0.2"});
+  EXPECT_DOUBLE_EQ(s.rebars[0].diameter, 4e-3);
+  EXPECT_DOUBLE_EQ(s.rebars[0].erosion_strain, 0.2);
+  try {
+    parse_scene(kHead + bar, "s.toml", "", {"rebar.1.diameter=4mm"});
+    ADD_FAILURE() << "a missing entry was taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no [[rebar]] entry with index 1"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(RebarScene, MassOfTheNodesIsTheBarsMass) {
   // A layer of 4 x 4 bars across the 100 mm slab and one 90 mm bar, elements of at most
   // 2.5 mm (half the cell): the nodes' lumped masses rho A L / 2 per element end add up to
