@@ -82,6 +82,7 @@ void decode_all(const std::string& path) {
     switch (static_cast<RecordType>(type)) {
       case RecordType::Frame:
       case RecordType::Escape:
+      case RecordType::Rebar:
         (void)r.read_frame();
         break;
       case RecordType::Checkpoint:

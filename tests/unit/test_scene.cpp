@@ -403,7 +403,7 @@ TEST(SceneErrors, FilesNameFileLineAndKey) {
        "outptu: unknown key (expected one of: scene, materials, bodies, loads, contact, grid, "
        "boundary, "
        "solver, "
-       "output)"},
+       "output, rebar)"},
       {"bad_unknown_nested.toml", 9, "materials.copper.strength.hardening: unknown key"},
       {"bad_unknown_material.toml", 8,
        "bodies.bar.material: unknown material 'copr' (known: copper)"},

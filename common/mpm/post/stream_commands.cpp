@@ -12,6 +12,7 @@
 #include "mpm/post/commands.hpp"
 #include "mpm/post/json.hpp"
 #include "mpm/scene/particles.hpp"
+#include "mpm/scene/rebar_elements.hpp"
 
 namespace mpm {
 
@@ -72,7 +73,20 @@ struct StreamContents {
   Budget budget;
   double factor = 1;      ///< extensive values per model unit to whole bodies
   bool external = false;  ///< faces, loads, gravity or rigid bodies change the momentum
+  struct RebarEntry {
+    double time;
+    std::size_t elements, eroded;
+  };
+  std::vector<RebarEntry> rebar;  ///< the REBR records: elements and those eroded
 };
+
+/// The rebar's elements and how many of them were eroded, per REBR record.
+void print_rebar_text(const StreamContents& c) {
+  if (c.rebar.empty()) return;
+  const auto& last = c.rebar.back();
+  std::printf("rebar: %zu elements, %zu eroded at t = %.4f us (%zu records)\n", last.elements,
+              last.eroded, last.time * 1e6, c.rebar.size());
+}
 
 void print_budget_json(JsonWriter& j, const StreamContents& c) {
   const Budget& b = c.budget;
@@ -148,6 +162,11 @@ void print_summary_json(const std::string& path, const StreamContents& c, const 
   j.end_array().key("history_rows").integer(c.hist_rows).key("ended").boolean(s.ended);
   j.key("status").integer(s.end_status).key("message").string(s.end_message);
   j.key("damage").string(s.damage);
+  if (!c.rebar.empty())
+    j.key("rebar_elements")
+        .integer(c.rebar.back().elements)
+        .key("rebar_eroded")
+        .integer(c.rebar.back().eroded);
   if (c.budget.any && c.budget.valid) print_budget_json(j, c);
   j.end_object();
   std::printf("%s\n", j.text().c_str());
@@ -172,6 +191,7 @@ void print_summary_text(const std::string& path, const StreamContents& c, const 
               s.ended ? ("status " + std::to_string(s.end_status) + ", " + s.end_message).c_str()
                       : "missing (the producer stopped early or is still running)");
   print_budget_text(c);
+  print_rebar_text(c);
   if (!s.damage.empty()) std::printf("damage: %s\n", s.damage.c_str());
 }
 
@@ -266,6 +286,13 @@ int post_summary(const SummaryArgs& a) {
     c.budget.frame(f);
   };
   v.escapes = [&](Frame&& f) { c.budget.escapes(f); };
+  v.rebar = [&](Frame&& f) {
+    const Column* e = f.columns.find(rebar_col::eroded);
+    std::size_t eroded = 0;
+    if (e && e->info().type == ScalarType::U8 && e->info().components == 1)
+      for (std::size_t k = 0; k < f.columns.size(); ++k) eroded += e->as<std::uint8_t>()[k] != 0;
+    c.rebar.push_back({f.time, f.columns.size(), eroded});
+  };
   v.history = [&](HistoryBlock&& h) {
     c.hist_rows += h.rows();
     if (c.hist_names.empty()) c.hist_names = h.names;

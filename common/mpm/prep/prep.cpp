@@ -17,6 +17,7 @@
 #include "mpm/prep/checks.hpp"
 #include "mpm/prep/graded_voxelise.hpp"
 #include "mpm/prep/initial_fields.hpp"
+#include "mpm/prep/rebar.hpp"
 #include "mpm/prep/region.hpp"
 #include "mpm/prep/resources.hpp"
 #include "mpm/prep/scene_needs.hpp"
@@ -92,6 +93,7 @@ void signal_speeds(const Scene& scene, const ColumnStore& cols, Estimates& e) {
   const auto* v = reinterpret_cast<const double*>(cols.at(col::v).data());
   const int d = scene.dimension;
   for (std::size_t i = 0; i < cols.size(); ++i) {
+    if (mat[i] == kRebarNode) continue;  // the truss wave's step: rebar_time_step
     double s2 = 0;
     for (int a = 0; a < d; ++a) s2 += v[i * d + a] * v[i * d + a];
     // Rigid bodies (kRigidMaterial) carry no waves: only their speed counts.
@@ -258,16 +260,48 @@ void print_estimates(const Scene& scene, const Estimates& e, std::size_t total) 
                  e.steps);
 }
 
+/// The summary's table of rebar: per [[rebar]] entry its bars, elements, nodes and mass
+/// against the exact mass rho A L_total.
+void print_rebar(const Scene& scene, const std::vector<RebarReport>& report) {
+  std::fprintf(stderr, "  %-14s %-12s %6s %9s %9s %10s %14s %14s %8s\n", "rebar", "material",
+               "bars", "elements", "nodes", "element", "mass kg", "exact kg", "error");
+  for (std::size_t r = 0; r < report.size(); ++r) {
+    const RebarReport& p = report[r];
+    std::fprintf(stderr, "  %-14s %-12s %6zu %9zu %9zu %7s mm %14.6g %14.6g %7.2f%%\n",
+                 scene.rebars[r].loc.key.c_str(),
+                 scene.materials[scene.rebars[r].material].name.c_str(), p.bars, p.elements,
+                 p.nodes, mm(p.element_length).c_str(), p.mass, p.exact_mass,
+                 p.exact_mass > 0 ? 100.0 * (p.mass - p.exact_mass) / p.exact_mass : 0.0);
+  }
+}
+
+/// The truss wave's step, cfl L_e / (sqrt(E / rho) + |v|) over the shortest element of each
+/// [[rebar]] entry, when it is shorter than the particles' (the estimate then follows it).
+void rebar_time_step(const Scene& scene, const std::vector<RebarReport>& report, Estimates& e) {
+  for (std::size_t r = 0; r < report.size(); ++r) {
+    const RebarSpec& b = scene.rebars[r];
+    const MaterialSpec& m = scene.materials[b.material];
+    const double c = std::sqrt(m.youngs_modulus / m.density) + scene.bodies[b.body].velocity.norm();
+    const double dt = std::min(scene.solver.dt_max, scene.solver.cfl * report[r].shortest / c);
+    if (report[r].elements > 0 && dt < e.dt) e.dt = dt, e.speed = e.speed_start = c;
+  }
+  e.steps = std::ceil(scene.solver.end_time / e.dt);
+}
+
 /// Writes the model stream: the scene `text`, the info (tool, version, seconds since t0, the
-/// bodies), the GRID record of a graded grid, and the particles.
+/// bodies), the GRID record of a graded grid, the particles and the rebar's elements (a REBR
+/// record, when the scene has rebar).
 void write_model(const PrepOptions& opt, const Scene& scene, const std::string& text,
                  const std::vector<BodyReport>& report, const GradedModel* graded, ColumnStore cols,
-                 double t0) {
+                 ColumnStore rebar, double t0) {
   std::vector<std::string> inputs{opt.scene};
   for (const auto& b : scene.bodies)
     if (!b.mesh_path.empty()) inputs.push_back(b.mesh_path);
+  for (const auto& b : scene.rebars)
+    if (!b.path.empty()) inputs.push_back(b.path);
   check_output_file(opt.output, inputs);
-  StreamWriter out(opt.output);
+  StreamWriter out(opt.output,
+                   scene.rebars.empty() ? kStreamMinorWithoutRebar : kStreamVersionMinor);
   out.write_text(RecordType::Scene, text);
   std::ostringstream info;
   info << "tool = \"mpm-prep\"\nversion = \"" << kVersion
@@ -282,6 +316,12 @@ void write_model(const PrepOptions& opt, const Scene& scene, const std::string& 
   frame.flags = kFrameModel;
   frame.columns = std::move(cols);
   out.write_frame(frame);
+  if (!scene.rebars.empty()) {
+    Frame elements;
+    elements.flags = kFrameModel;
+    elements.columns = std::move(rebar);
+    out.write_rebar(elements);
+  }
   out.write_end(0, "model");
   out.close();
 }
@@ -327,13 +367,17 @@ int prepare_model(const PrepOptions& opt) {
   if (!scene.grid.levels.empty()) graded = prepare_graded(scene, lattice, report);
   ColumnStore cols =
       graded ? std::move(graded->columns) : voxelise(scene, lattice, report, progress_cells(scene));
-  apply_initial_fields(scene, cols);  // spin, velocity and stress fields
+  apply_initial_fields(scene, cols);      // spin, velocity and stress fields
+  std::vector<RebarReport> rebar_report;  // truss elements, nodes after the bodies' particles
+  ColumnStore rebar = discretise_rebar(scene, lattice, boxes.lo, boxes.hi, cols, rebar_report);
   const GradedModel* graded_grid = graded ? &*graded : nullptr;
   const std::string text = with_explicit_domain(scene.toml, lattice);
-  const Estimates estimates = estimate_run(scene, lattice, cols, graded_grid);
+  Estimates estimates = estimate_run(scene, lattice, cols, graded_grid);
+  if (!rebar_report.empty()) rebar_time_step(scene, rebar_report, estimates);
   if (!opt.quiet) {
     print_grid(scene, lattice, graded_grid);
     const std::size_t total = print_bodies(scene, report);
+    if (!rebar_report.empty()) print_rebar(scene, rebar_report);
     print_materials(scene, graded_grid ? graded_grid->h_min : lattice.h);
     print_estimates(scene, estimates, total);
     if (proposal) print_proposal(*proposal, double(total) * estimates.steps);
@@ -343,7 +387,7 @@ int prepare_model(const PrepOptions& opt) {
   warnings.clear();
   overlap_warnings(scene, report, warnings);
   print_warnings(warnings);
-  write_model(opt, scene, text, report, graded_grid, std::move(cols), t0);
+  write_model(opt, scene, text, report, graded_grid, std::move(cols), std::move(rebar), t0);
   return kExitOk;
 }
 

@@ -72,7 +72,7 @@ void equation_of_state(const Scene& scene, const ColumnStore& cols, std::vector<
   const int d = scene.dimension;
   std::vector<double> v_max(scene.materials.size(), 0.0);
   for (std::size_t i = 0; i < cols.size(); ++i) {
-    if (mat[i] == kRigidMaterial) continue;
+    if (mat[i] >= scene.materials.size()) continue;  // rigid particles, rebar nodes
     double s2 = 0;
     for (int a = 0; a < d; ++a) s2 += v[i * d + a] * v[i * d + a];
     v_max[mat[i]] = std::max(v_max[mat[i]], std::sqrt(s2));

@@ -59,6 +59,10 @@ class History {
       const std::string pair = scene.bodies[c.body_a].name + "_" + scene.bodies[c.body_b].name;
       for (int a = 0; a < dim; ++a) add("contact_" + pair + "_" + "xyz"[a], "N");
     }
+    if (!scene.rebars.empty()) {  // the rebar's elements eroded so far
+      rebar_ = true;
+      add("rebar_eroded", "-");
+    }
     add_body_columns(scene);
     if (implicit_) {
       // Work of the implicit solver since the previous row, then totals since t = 0.
@@ -95,6 +99,8 @@ class History {
     if constexpr (requires { s.contact_force(); })
       for (const Vec3& f : s.contact_force())
         for (int a = 0; a < dim_; ++a) row.push_back(factor_ * f[a]);
+    if constexpr (requires { s.eroded_elements(); })
+      if (rebar_) row.push_back(double(s.eroded_elements()));
     if (!bodies_.empty()) body_values(const_cast<Solver&>(s).particles(), row);
     if constexpr (HasImplicitWork<Solver>) {
       const ImplicitWork& w = s.work();
@@ -171,6 +177,7 @@ class History {
   ImplicitWork last_;     ///< totals at the previous row
   long last_step_ = -1;   ///< step of the last row
   bool removed_ = false;  ///< columns of what left the domain (solver.on_exit = "remove")
+  bool rebar_ = false;    ///< the column of the rebar's eroded elements
   std::vector<int> faces_, rigid_;
   std::vector<int> bodies_;  ///< deformable bodies with history columns (output.body_history)
   std::vector<int> slot_;    ///< by body: its index in bodies_, -1 when it has no columns

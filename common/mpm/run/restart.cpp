@@ -86,14 +86,17 @@ void check_restartable(const std::string& path, const RestartScan& scan) {
                          "; run the model again");
 }
 
-Checkpoint load_checkpoint(const std::string& path, const RestartScan& scan) {
+Checkpoint load_checkpoint(const std::string& path, const RestartScan& scan, Frame* rebar) {
   StreamReader r(path);
   std::size_t seen = 0;
   std::uint32_t type = 0;
   while (r.next(type)) {
     if (static_cast<RecordType>(type) == RecordType::Checkpoint && ++seen == scan.checkpoints)
       return r.read_checkpoint();
-    r.skip();
+    if (rebar && static_cast<RecordType>(type) == RecordType::Rebar)
+      *rebar = r.read_frame();
+    else
+      r.skip();
   }
   throw StreamError(path, "changed while it was read: its checkpoint " +
                               std::to_string(scan.checkpoints) + " is gone");

@@ -60,7 +60,9 @@ RestartScan scan_for_restart(const std::string& path);
 /// (killed, cut, or stopped by a signal) and left a checkpoint. InputError otherwise.
 void check_restartable(const std::string& path, const RestartScan& scan);
 
-/// The last intact checkpoint of the scanned stream.
-Checkpoint load_checkpoint(const std::string& path, const RestartScan& scan);
+/// The last intact checkpoint of the scanned stream; with `rebar`, also the last REBR record
+/// before it (the rebar's elements at the checkpoint; none: left empty).
+Checkpoint load_checkpoint(const std::string& path, const RestartScan& scan,
+                           Frame* rebar = nullptr);
 
 }  // namespace mpm

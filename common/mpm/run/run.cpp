@@ -71,6 +71,7 @@ extern "C" void on_signal(int sig) {
 struct Model {
   std::string scene_text;
   Frame frame;
+  Frame rebar;  ///< the REBR record: the rebar's elements (no columns without rebar)
 };
 
 /// Refuses, before the particles are read, a model whose run would need more than `limit`
@@ -129,6 +130,9 @@ Model read_model(const RunOptions& opt) {
   };
   v.frame = [&](Frame&& f) {
     if (!have_frame) model.frame = std::move(f), have_frame = true;
+  };
+  v.rebar = [&](Frame&& f) {
+    if (model.rebar.columns.columns().empty()) model.rebar = std::move(f);
   };
   const StreamSummary s = read_stream(path, v);
   const std::string name = path == "-" ? "stdin" : path;
@@ -220,6 +224,7 @@ void print_stats(Solver& solver, int threads, double loop_wall) {
 struct Restart {
   RestartScan scan;
   Checkpoint checkpoint;
+  Frame rebar;  ///< the rebar's elements at the checkpoint (the REBR record before it)
 };
 
 /// True for a solver whose state a checkpoint holds: the explicit solver on a uniform or
@@ -244,12 +249,13 @@ class TimeLoop {
 
  public:
   TimeLoop(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Solver& solver,
-           const Restart* restart)
+           const Restart* restart, ColumnStore* rebar)
       : opt_(opt),
         o_(scene.output),
         end_(scene.solver.end_time),
         solver_(solver),
         restart_(restart),
+        rebar_(rebar),
         history_(Solver::D, scene, kImplicit),
         extremes_(scene),
         checkpoint_(scene.output, solver.time()),
@@ -261,7 +267,8 @@ class TimeLoop {
       next_history_ = s.get("next_history");
       checkpoint_.restore(s);
     } else {
-      out_ = std::make_unique<StreamWriter>(opt.output);
+      out_ = std::make_unique<StreamWriter>(opt.output,
+                                            rebar ? kStreamVersionMinor : kStreamMinorWithoutRebar);
       out_->write_text(RecordType::Scene, scene.toml);
       out_->write_text(RecordType::Info, run_info(scene, lattice, omp_get_max_threads()));
       next_history_ = o_.history_interval;
@@ -303,7 +310,23 @@ class TimeLoop {
     write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
     emit_grid();
     write_particles(flags, [&](const Frame& f) { out_->write_frame(f, o_.fields, o_.precision); });
+    if (rebar_) write_rebar(flags);  // the elements' state at the frame (after it)
     extremes_.sample(solver_.particles(), solver_.time());
+  }
+  /// A REBR record: the rebar's elements now, written without copying them.
+  void write_rebar(std::uint32_t flags) {
+    Frame e;
+    e.step = solver_.steps();
+    e.time = solver_.time();
+    e.flags = flags;
+    std::swap(e.columns, *rebar_);
+    try {
+      out_->write_rebar(e);
+    } catch (...) {
+      std::swap(e.columns, *rebar_);
+      throw;
+    }
+    std::swap(e.columns, *rebar_);
   }
   /// A CHKP record: the particles in cell order (settle) with the state the columns do not
   /// hold; the history rows before it are flushed first, so the stream up to it is complete.
@@ -318,6 +341,7 @@ class TimeLoop {
       s.set("frame", frame_);
       s.set("next_history", next_history_);
       checkpoint_.save(s);
+      if (rebar_) write_rebar(0);  // the elements' state, before the checkpoint it goes with
       write_particles(0, [&](const Frame& f) { out_->write_checkpoint(s, f); });
       checkpoint_.written();
     }
@@ -326,14 +350,15 @@ class TimeLoop {
   /// particles are due for a re-sort (at most kSignalWait steps on), after a checkpoint.
   bool stop_for_signal() {
     if (!g_signal) return false;
-    if constexpr (kCheckpoints<Solver>) {
+    constexpr bool checkpoint = kCheckpoints<Solver>;
+    if (checkpoint) {
       if (!solver_.sort_pending() && ++signal_wait_ <= kSignalWait) return false;
       write_checkpoint();
     }
     status_ = 128 + g_signal;
     message_ = "interrupted by signal " + std::to_string(int(g_signal)) +
                " at t = " + std::to_string(solver_.time()) + " s; the last frame is the state then";
-    if constexpr (kCheckpoints<Solver>)
+    if (checkpoint)
       message_ += opt_.output == "-"
                       ? "; the stream holds a checkpoint of it: saved to a file, it continues "
                         "with mpm-run --restart FILE"
@@ -349,6 +374,7 @@ class TimeLoop {
   const double end_;
   Solver& solver_;
   const Restart* restart_;
+  ColumnStore* rebar_;  ///< the rebar's element table, or null
   std::unique_ptr<StreamWriter> out_;
   History history_;
   MaterialExtremes extremes_;  ///< sampled at each frame, reported at the end
@@ -451,7 +477,9 @@ void TimeLoop<Solver>::report(double loop_wall) const {
 
 template <class Solver>
 int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Solver& solver,
-               const Restart* restart) {
+               const Restart* restart, ColumnStore* rebar = nullptr) {
+  if constexpr (requires { solver.attach_rebar(*rebar); })
+    if (rebar) solver.attach_rebar(*rebar);
   if constexpr (kCheckpoints<Solver>) {
     if (restart) solver.restore_state(restart->checkpoint.state);
   } else if (scene.output.checkpoint_time > 0 || scene.output.checkpoint_wall > 0) {
@@ -462,13 +490,13 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
                          : "graded grids do not write checkpoints (the window of their levels is "
                            "not saved yet); remove output.checkpoint");
   }
-  TimeLoop<Solver> loop(opt, scene, lattice, solver, restart);
+  TimeLoop<Solver> loop(opt, scene, lattice, solver, restart, rebar);
   return loop();
 }
 
 template <int D>
 int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame& model,
-        const Restart* restart) {
+        const Restart* restart, ColumnStore* rebar = nullptr) {
   const bool graded = !scene.grid.levels.empty();  // mesh grading (004, section 3)
   if (scene.solver.type == SolverType::Implicit) {
     if (graded)
@@ -496,7 +524,7 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
                        "[[grid.levels]] (use colored, lr-slabs or array-expansion)");
     ExplicitSolver<GradedGrid<D>> solver(scene, GradedGrid<D>(lattice, scene), model.columns,
                                          strategy);
-    return run_solver(opt, scene, lattice, solver, restart);
+    return run_solver(opt, scene, lattice, solver, restart, rebar);
   }
   if (scene.grid.sparse) {
     if (strategy == ScatterStrategy::Patch)
@@ -506,10 +534,10 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
                        "array-expansion");
     ExplicitSolver<SparseGrid<D>> solver(scene, SparseGrid<D>(lattice, scene.boundary),
                                          model.columns, strategy);
-    return run_solver(opt, scene, lattice, solver, restart);
+    return run_solver(opt, scene, lattice, solver, restart, rebar);
   }
   UniformSolver<D> solver(scene, UniformGrid<D>(lattice, scene.boundary), model.columns, strategy);
-  return run_solver(opt, scene, lattice, solver, restart);
+  return run_solver(opt, scene, lattice, solver, restart, rebar);
 }
 
 /// mpm-run --restart: the run of a result stream continued from its last intact checkpoint.
@@ -530,7 +558,13 @@ int restart_model(const RunOptions& opt) {
                      "runs on graded grids cannot be continued: their checkpoints are not "
                      "written yet; run the model again");
   check_restartable(opt.restart, restart.scan);
-  restart.checkpoint = load_checkpoint(opt.restart, restart.scan);
+  restart.checkpoint = load_checkpoint(opt.restart, restart.scan, &restart.rebar);
+  ColumnStore* rebar = nullptr;
+  if (!scene.rebars.empty()) {
+    if (restart.rebar.columns.columns().empty())
+      throw StreamError(opt.restart, "its checkpoint has no rebar elements (REBR) before it");
+    rebar = &restart.rebar.columns;
+  }
   const RestartScan& s = restart.scan;
   std::fprintf(stderr,
                "mpm-run: continuing %s from its checkpoint at step %ld, t = %g s; the %zu "
@@ -543,8 +577,8 @@ int restart_model(const RunOptions& opt) {
                                  : "cut at a record boundary");
   const Lattice lattice = make_lattice(scene);
   Frame& particles = restart.checkpoint.frame;
-  if (scene.dimension == 3) return run<3>(opt, scene, lattice, particles, &restart);
-  return run<2>(opt, scene, lattice, particles, &restart);
+  if (scene.dimension == 3) return run<3>(opt, scene, lattice, particles, &restart, rebar);
+  return run<2>(opt, scene, lattice, particles, &restart, rebar);
 }
 
 }  // namespace
@@ -561,8 +595,15 @@ int run_model(const RunOptions& opt) {
   const std::string name = (opt.input == "-" ? std::string("stdin") : opt.input) + " (scene)";
   const Scene scene = parse_scene(model.scene_text, name, "", opt.overrides);
   const Lattice lattice = make_lattice(scene);
-  if (scene.dimension == 3) return run<3>(opt, scene, lattice, model.frame, nullptr);
-  return run<2>(opt, scene, lattice, model.frame, nullptr);
+  const bool has_rebar = !model.rebar.columns.columns().empty();
+  if (has_rebar != !scene.rebars.empty())
+    throw InputError(name, has_rebar ? "the model holds rebar elements (REBR) but its scene no "
+                                       "[[rebar]]"
+                                     : "the scene has [[rebar]] but the model holds no rebar "
+                                       "elements (REBR): make it again with this mpm-prep");
+  ColumnStore* rebar = has_rebar ? &model.rebar.columns : nullptr;
+  if (scene.dimension == 3) return run<3>(opt, scene, lattice, model.frame, nullptr, rebar);
+  return run<2>(opt, scene, lattice, model.frame, nullptr, rebar);
 }
 
 }  // namespace mpm

@@ -70,6 +70,7 @@ void prepare_columns(ColumnStore& cols, const Scene& scene) {
                                     std::to_string(body[i]) + " but the scene has " +
                                     std::to_string(scene.bodies.size()));
     if (mat[i] == kRigidMaterial && scene.bodies[body[i]].rigid) continue;
+    if (mat[i] == kRebarNode && !scene.rebars.empty()) continue;
     if (mat[i] >= scene.materials.size())
       throw InputError("model", "particle " + std::to_string(i) + " refers to material " +
                                     std::to_string(mat[i]) + " but the scene has " +
@@ -97,8 +98,10 @@ void prepare_columns(ColumnStore& cols, const Scene& scene) {
     cols.add({col::T, ScalarType::F64, 1, "K"});
     double* T = cols.get<double>(col::T);
     for (std::size_t i = 0; i < cols.size(); ++i)
-      T[i] = mat[i] == kRigidMaterial ? 0.0 : scene.materials[mat[i]].strength.room_temperature;
+      T[i] = mat[i] >= scene.materials.size() ? 0.0  // rigid particles, rebar nodes
+                                              : scene.materials[mat[i]].strength.room_temperature;
   }
+  if (!scene.rebars.empty()) ensure(cols, {col::f_rebar, ScalarType::F64, d, "N"});
   if (!scene.loads.empty() && !cols.has(col::f_ext)) {
     // Each load's total force, shared equally among the particles of its body whose position
     // at t = 0 lies in its region. Axisymmetric: the force is over the whole ring, the
@@ -143,6 +146,7 @@ ParticleView<D> view(ColumnStore& cols) {
   p.damage = cols.get<double>(col::damage);
   p.mu_max = cols.get<double>(col::mu_max);
   p.f_ext = cols.get<Vec<D>>(col::f_ext);
+  p.f_rebar = cols.get<Vec<D>>(col::f_rebar);
   p.strain = cols.get<Vec<D>>(col::strain);
   p.thickness = cols.get<double>(col::thickness);
   p.id = cols.get<std::uint32_t>(col::id);
@@ -159,7 +163,7 @@ double run_particle_bytes(const Scene& scene) {
   // x and v, m, rho and e, sigma, id, material and body, then the optional columns.
   return 2 * d * 8 + 3 * 8 + 48 + 4 + 1 + 1 + (need.eps_p ? 8 : 0) + (need.T ? 8 : 0) +
          (need.failed ? 1 : 0) + (need.damage ? 8 : 0) + (need.mu_max ? 8 : 0) +
-         (d == 2 && scene.plane_stress ? 8 : 0);
+         (d == 2 && scene.plane_stress ? 8 : 0) + (scene.rebars.empty() ? 0 : d * 8);
 }
 
 }  // namespace mpm

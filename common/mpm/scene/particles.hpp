@@ -29,6 +29,7 @@ inline const std::string failed = "failed";      ///< u8, 1 once the failure cri
 inline const std::string damage = "damage";      ///< f64, HJC damage D in [0, 1]
 inline const std::string mu_max = "mu_max";      ///< f64, HJC: largest compression rho/rho0 - 1
 inline const std::string f_ext = "f_ext";        ///< D x f64, applied force (loads), N
+inline const std::string f_rebar = "f_rebar";    ///< D x f64, rebar elements' force on a node, N
 inline const std::string strain = "strain";  ///< D x f64, accumulated normal strains (graded grids)
 inline const std::string level =
     "level";  ///< u8, grid level of the particle's spacing (graded grids)
@@ -38,6 +39,10 @@ inline const std::string thickness =
 
 /// Material id of the particles of rigid bodies (they have no material).
 inline constexpr std::uint8_t kRigidMaterial = 255;
+/// Material id of the node particles of rebar (rebar_elements.hpp): they carry mass, position
+/// and velocity, no stress and no volume of their own (004, section 2); their elements carry
+/// the material.
+inline constexpr std::uint8_t kRebarNode = 254;
 
 /// Read access to a body column of either width: u8, or u32 in models of more than 255
 /// bodies (stream format 1.4). Empty when there is no column.
@@ -75,6 +80,7 @@ struct ParticleView {
   double* damage = nullptr;  ///< HJC damage
   double* mu_max = nullptr;  ///< HJC largest compression
   Vec<D>* f_ext = nullptr;
+  Vec<D>* f_rebar = nullptr;    ///< the rebar elements' force on their nodes (scenes with rebar)
   Vec<D>* strain = nullptr;     ///< integral of the rate of deformation's diagonal (graded grids)
   double* thickness = nullptr;  ///< thickness / initial thickness (plane stress)
   std::uint32_t* id = nullptr;

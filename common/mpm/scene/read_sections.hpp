@@ -14,6 +14,8 @@ void read_bodies(Reader& top, Scene& s);
 void read_loads(Reader& top, Scene& s);
 /// [[contact]]: body pairs with their own velocity fields (read_bodies.cpp).
 void read_contacts(Reader& top, Scene& s);
+/// [[rebar]]: bars, layers and polyline files of truss elements (read_rebar.cpp).
+void read_rebars(Reader& top, Scene& s);
 /// [grid] with its domain and [[grid.levels]] (read_grid.cpp).
 void read_grid(Reader& r, Scene& s);
 /// A body's own particle spacing against the grid (bodies are read before [grid]).

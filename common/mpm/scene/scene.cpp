@@ -63,14 +63,15 @@ void check_axisymmetric(const Scene& s) {
 }
 
 void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
-  Reader top(
-      doc, root, "", Origin{},
-      {"scene", "materials", "bodies", "loads", "contact", "grid", "boundary", "solver", "output"});
+  Reader top(doc, root, "", Origin{},
+             {"scene", "materials", "bodies", "loads", "contact", "grid", "boundary", "solver",
+              "output", "rebar"});
   read_scene_table(top, s);
   read_materials(top, s);
   read_bodies(top, s);
   read_loads(top, s);
   read_contacts(top, s);
+  read_rebars(top, s);
 
   {
     Reader g = top.required_table("grid", {"cell_size", "domain", "padding", "sparse", "levels"},
@@ -106,6 +107,12 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
       if (m.strength.model == StrengthModel::Hjc)
         throw InputError(where(m.loc.file, m.loc.line, m.loc.key),
                          "HJC concrete needs the explicit solver (solver.type = \"explicit\")");
+  if (!s.rebars.empty() && (s.dimension != 3 || s.solver.type == SolverType::Implicit)) {
+    const SourceLoc& c = s.rebars.front().loc;
+    throw InputError(where(c.file, c.line, c.key),
+                     "rebar needs a 3D scene and the explicit solver (truss elements in "
+                     "3D, 004 section 2)");
+  }
   top.finish();
 }
 

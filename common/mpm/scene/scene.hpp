@@ -217,6 +217,41 @@ struct GridSpec {
   }
 };
 
+/// Reinforcing bars (004, section 2: HFEMP): truss elements whose nodes are particles.
+enum class RebarShape { Bar, Layer, Polyline };
+
+/// A [[rebar]] entry: one straight bar, a square-pattern layer of bars, or the polylines of a
+/// file, of one section and one material, cut into truss elements by mpm-prep.
+struct RebarSpec {
+  RebarShape shape = RebarShape::Bar;
+  int material = -1;  ///< index into Scene::materials: its density, E and yield stress
+  /// Index into Scene::bodies: the body the bars lie in (their nodes count as its particles in
+  /// histories and share its velocity field); default the first deformable body.
+  int body = -1;
+  double diameter = 0;        ///< m; the section is pi d^2 / 4
+  double element_length = 0;  ///< m, at most; 0: half the cell size
+  /// Plastic strain past which an element is eroded (removed; its nodes keep their mass);
+  /// default the material's failure.plastic_strain, else none.
+  double erosion_strain = std::numeric_limits<double>::infinity();
+  Vec3 start = Vec3::Zero(), end = Vec3::Zero();  ///< bar: its end points, m
+  /// Layer: the axis normal to its plane (0 x, 1 y, 2 z); the in-plane axes are a = normal + 1,
+  /// b = normal + 2 (mod 3).
+  int normal = 2;
+  bool offset_given = false;
+  double offset = 0;            ///< layer: the plane's coordinate along the normal, m
+  double cover = 0;             ///< layer, without offset: body face to the bars' surface, m
+  bool cover_from_max = false;  ///< layer: the cover is from the body's upper face
+  double pitch = 0;             ///< layer: distance between neighbouring bars, m
+  /// Layer: bars parallel to a (spaced along b), bars parallel to b (spaced along a).
+  std::array<int, 2> count{0, 0};
+  /// Layer: the in-plane coordinates (a, b) where the first bars of the two families cross;
+  /// unset: the pattern is centred on the body's bounding box.
+  bool first_given = false;
+  std::array<double, 2> first{0, 0};
+  std::string path;  ///< polyline: the file (relative to the scene's directory)
+  SourceLoc loc;     ///< key "rebar.<index>"
+};
+
 enum class BoundaryType { Free, Slip, Fixed };
 /// Faces in the order x_min, x_max, y_min, y_max, z_min, z_max.
 struct BoundarySpec {
@@ -312,6 +347,7 @@ struct Scene {
   std::vector<BodySpec> bodies;
   std::vector<LoadSpec> loads;
   std::vector<ContactSpec> contacts;  ///< body pairs in contact; empty: one velocity field
+  std::vector<RebarSpec> rebars;      ///< reinforcing bars ([[rebar]]); empty: none
   GridSpec grid;
   BoundarySpec boundary;
   SolverSpec solver;

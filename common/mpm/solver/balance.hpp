@@ -108,6 +108,7 @@ double start_balance(const ParticleView<D>& p, const std::vector<Material>& mate
     balance.kinetic += 0.5 * p.m[i] * p.v[i].squaredNorm();
     balance.internal += p.m[i] * p.e[i];
     for (int a = 0; a < D; ++a) balance.momentum[a] += p.m[i] * p.v[i][a];
+    if (p.material[i] == kRebarNode) continue;  // their elements' step: RebarTruss
     speed = std::max(speed, materials[p.material[i]].reference_wave_speed() + p.v[i].norm());
   }
   return speed;

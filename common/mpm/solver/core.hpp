@@ -228,6 +228,7 @@ class SolverCore {
   long steps_ = 0;
   double particle_steps_ = 0;
   bool need_sort_ = true;
+  long sorts_ = 0;  ///< sorts so far (a sort reorders the particles: indices change)
   const std::uint8_t* material_ = nullptr;  ///< refreshed with every view
   std::vector<std::uint32_t> exits_;  ///< particles that left the domain, removed at next sort
   std::size_t removed_count_ = 0;
@@ -274,6 +275,7 @@ void SolverCore<GridT>::sort_particles() {
   binning_.sort(particles_, grid_, exits_);
   exits_.clear();
   need_sort_ = false;
+  ++sorts_;
   material_ = view<D>(particles_).material;
 }
 

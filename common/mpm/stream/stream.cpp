@@ -116,6 +116,7 @@ bool known_type(std::uint32_t type) {
     case RecordType::History:
     case RecordType::Grid:
     case RecordType::Escape:
+    case RecordType::Rebar:
     case RecordType::Checkpoint:
     case RecordType::End:
       return true;
@@ -166,7 +167,7 @@ std::string record_name(std::uint32_t type) {
 // ---------------------------------------------------------------------------------------------
 // Writer
 
-StreamWriter::StreamWriter(const std::string& path) : path_(path) {
+StreamWriter::StreamWriter(const std::string& path, std::uint16_t minor) : path_(path) {
   if (path == "-") {
     f_ = stdout;
 #ifdef _WIN32
@@ -180,7 +181,7 @@ StreamWriter::StreamWriter(const std::string& path) : path_(path) {
   Bytes h;
   h.b.append(reinterpret_cast<const char*>(kMagic), sizeof kMagic);
   h.put(kStreamVersionMajor);
-  h.put(kStreamVersionMinor);
+  h.put(minor);
   h.put(std::uint32_t(0));
   errno = 0;
   if (std::fwrite(h.b.data(), 1, h.b.size(), f_) != h.b.size()) fail_io(errno ? errno : EIO);
@@ -273,6 +274,10 @@ void StreamWriter::write_frame(const Frame& frame, const std::vector<std::string
 
 void StreamWriter::write_escapes(const Frame& escaped) {
   write_columns(RecordType::Escape, {}, escaped, {}, Precision::Float64);
+}
+
+void StreamWriter::write_rebar(const Frame& elements) {
+  write_columns(RecordType::Rebar, {}, elements, {}, Precision::Float64);
 }
 
 void StreamWriter::write_columns(RecordType type, const std::string& prefix, const Frame& frame,
@@ -529,7 +534,8 @@ void StreamReader::skip() {
 
 Frame StreamReader::read_frame() {
   if (!pending_ ||
-      (type_ != std::uint32_t(RecordType::Frame) && type_ != std::uint32_t(RecordType::Escape)))
+      (type_ != std::uint32_t(RecordType::Frame) && type_ != std::uint32_t(RecordType::Escape) &&
+       type_ != std::uint32_t(RecordType::Rebar)))
     throw std::logic_error("StreamReader::read_frame: the current record is not a frame");
   return read_frame_body();
 }
@@ -717,6 +723,12 @@ StreamSummary read_stream(const std::string& path, const StreamVisitor& visitor)
           else
             r.skip();
           break;
+        case RecordType::Rebar:
+          if (visitor.rebar)
+            frame = r.read_frame();
+          else
+            r.skip();
+          break;
         default:
           r.skip();  // a record type of a later minor version
       }
@@ -744,6 +756,9 @@ StreamSummary read_stream(const std::string& path, const StreamVisitor& visitor)
         break;
       case RecordType::Escape:
         if (visitor.escapes) visitor.escapes(std::move(frame));
+        break;
+      case RecordType::Rebar:
+        if (visitor.rebar) visitor.rebar(std::move(frame));
         break;
       case RecordType::End:
         s.ended = true;

@@ -18,8 +18,11 @@ namespace mpm {
 
 inline constexpr std::uint16_t kStreamVersionMajor = 1;  ///< readers refuse other majors
 /// Readers accept any minor (1: GRID; 2: CHKP; 3: ESCP; 4: the body column u32 in models of
-/// more than 255 bodies).
-inline constexpr std::uint16_t kStreamVersionMinor = 4;
+/// more than 255 bodies; 5: REBR).
+inline constexpr std::uint16_t kStreamVersionMinor = 5;
+/// The minor a writer stamps unless told otherwise: a stream without REBR records is a 1.4
+/// stream, byte for byte (stream_minor in docs/format.md: the lowest minor its records need).
+inline constexpr std::uint16_t kStreamMinorWithoutRebar = 4;
 
 /// Record types (little-endian fourcc).
 enum class RecordType : std::uint32_t {
@@ -31,6 +34,7 @@ enum class RecordType : std::uint32_t {
   Grid = 0x44495247,     ///< "GRID": a graded grid's nodes and cells (since 1.1; graded_grid.hpp)
   Checkpoint = 0x504B4843,  ///< "CHKP": a solver's whole state, for mpm-run --restart (since 1.2)
   Escape = 0x50435345,      ///< "ESCP": particles that left the domain, as a frame (since 1.3)
+  Rebar = 0x52424552,       ///< "REBR": truss elements of rebar, laid out as a frame (since 1.5)
 };
 /// "SCEN", "FRAM", ... for messages; "?xyz" style hex for unknown codes.
 std::string record_name(std::uint32_t type);
@@ -68,8 +72,9 @@ struct HistoryBlock {
 /// reader at the other end of a pipe sees frames as they come.
 class StreamWriter {
  public:
-  /// Opens the file (or takes stdout for "-") and writes the 16-byte header; throws IoError.
-  explicit StreamWriter(const std::string& path);
+  /// Opens the file (or takes stdout for "-") and writes the 16-byte header with the minor
+  /// version `minor` (kStreamVersionMinor for a stream that holds REBR records); throws IoError.
+  explicit StreamWriter(const std::string& path, std::uint16_t minor = kStreamMinorWithoutRebar);
   /// Continues the stream `source` after its first `keep` bytes (the header and whole
   /// records): when `path` is that file (by any name), cuts it there and appends to it;
   /// otherwise (another file, or "-") copies those bytes first. Throws IoError.
@@ -88,6 +93,9 @@ class StreamWriter {
   /// Writes an ESCP record: the particles that left the domain, every column in f64 (the
   /// layout of a frame; docs/format.md).
   void write_escapes(const Frame& escaped);
+  /// Writes a REBR record: the rebar's truss elements and their state (columns of
+  /// rebar_elements.hpp) at the frame's step and time, every column as stored.
+  void write_rebar(const Frame& elements);
   /// Writes a CHKP record: the state values, then every column of the frame as stored (f64
   /// stays f64).
   void write_checkpoint(const StateValues& state, const Frame& frame);
@@ -146,7 +154,7 @@ class StreamReader {
   bool next(std::uint32_t& type);
   /// The payload of the current record (checked against its CRC).
   std::vector<std::byte> read_payload();
-  /// The current record as a frame (must be a FRAM or ESCP record), decoded straight into
+  /// The current record as a frame (must be a FRAM, ESCP or REBR record), decoded straight into
   /// columns; f32 columns are widened to f64. Checked against its CRC.
   Frame read_frame();
   /// The current record as a checkpoint (must be a CHKP record). Checked against its CRC.
@@ -207,6 +215,8 @@ struct StreamVisitor {
   std::function<void(std::vector<std::byte>&&)> grid;
   /// ESCP records: particles that left the domain, as a frame (since 1.2); skipped when empty.
   std::function<void(Frame&&)> escapes;
+  /// REBR records: the rebar's elements, as a frame (since 1.5); skipped when empty.
+  std::function<void(Frame&&)> rebar;
   bool want_frames = true;  ///< false: frames are skipped without decoding
 };
 

@@ -455,9 +455,18 @@ void render_png(const Frame& frame, int dim, const RenderOptions& options,
   if (x_display.get()) window->SetDisplayId(x_display.get());
   window->SetOffScreenRendering(1);
   window->SetMultiSamples(0);
-  window->SetNumberOfLayers(2);
+  window->SetNumberOfLayers(3);
   window->AddRenderer(scene);
   window->AddRenderer(overlay);
+  vtkNew<vtkRenderer> bars;  // rebar over the particles: layer 2, the scene's camera
+  if (!options.rebar.lines.empty()) {
+    bars->SetLayer(2);
+    bars->SetViewport(scene_vp[0], scene_vp[1], scene_vp[2], scene_vp[3]);
+    bars->SetActiveCamera(scene->GetActiveCamera());
+    bars->AddActor(rebar_actor(options.rebar, options.symmetry, section, drawn.keep_greater));
+    bars->InteractiveOff();
+    window->AddRenderer(bars);
+  }
   window->SetSize(w, h);
 
   const double scale = fit_camera(scene, view, bounds, radius, scene_vp, w, h);

@@ -2,7 +2,9 @@
 /// What a picture looks at (internal to mpm_vtk): the section plane, the camera's direction,
 /// the particles drawn (the whole body of a quarter or half model: mirror images), and the
 /// annotations that say so (a scale bar in a length unit, the view direction).
+#include <vtkActor.h>
 #include <vtkRenderer.h>
+#include <vtkSmartPointer.h>
 
 #include <array>
 #include <cstdint>
@@ -11,9 +13,17 @@
 
 #include "mpm/post/symmetry.hpp"
 #include "mpm/post/vtk/render_fields.hpp"
+#include "mpm/post/vtk/vtk_output.hpp"
 #include "mpm/stream/stream.hpp"
 
 namespace mpm::vtk_internal {
+
+struct Section;
+/// Rebar as red lines, its eroded elements left out (rebar_writer.cpp), with its images in the
+/// symmetry's planes and on the kept side of a section: drawn over the particles, in a layer
+/// of its own, so that bars inside the material show.
+vtkSmartPointer<vtkActor> rebar_actor(const RebarLines& rebar, const Symmetry& symmetry,
+                                      const Section& section, bool keep_greater);
 
 /// A section plane x_axis = position; the picture keeps one side and looks square at the cut.
 struct Section {

@@ -45,10 +45,12 @@ int post_vtk(const VtkArgs& a) {
   const std::string& dir = a.directory;
   const std::string& name = a.name;
   make_directory(dir);
-  std::vector<std::pair<double, std::string>> entries;
+  std::vector<std::pair<double, std::string>> entries, bars;
   std::size_t index = 0;
+  std::optional<Frame> last;  // the frame just written: the REBR record after it is its rebar
   StreamVisitor v;
   v.frame = [&](Frame&& f) {
+    last.reset();
     if (index++ % std::size_t(a.every) != 0 && !(f.flags & kFrameFinal)) return;
     const int dim = f.columns.at("x").info().components;
     char file[256];
@@ -56,6 +58,18 @@ int post_vtk(const VtkArgs& a) {
     write_vtu(f, dim, (std::filesystem::path(dir) / file).string());
     entries.emplace_back(f.time, file);
     write_pvd(entries, (std::filesystem::path(dir) / (name + ".pvd")).string());
+    last = std::move(f);
+  };
+  // Rebar: each frame's elements as <name>_rebar_NNNN.vtu (line cells), in <name>_rebar.pvd.
+  v.rebar = [&](Frame&& e) {
+    if (!last) return;
+    char file[256];
+    std::snprintf(file, sizeof file, "%s_rebar_%04zu.vtu", name.c_str(), bars.size());
+    write_rebar_vtu(rebar_lines(*last, e), e.time, e.step,
+                    (std::filesystem::path(dir) / file).string());
+    bars.emplace_back(e.time, file);
+    write_pvd(bars, (std::filesystem::path(dir) / (name + "_rebar.pvd")).string());
+    last.reset();
   };
   // Graded grids: each GRID record as <name>_grid_NNNN.vtu, listed by time in <name>_grid.pvd.
   std::vector<std::pair<double, std::string>> grids;
@@ -75,6 +89,12 @@ int post_vtk(const VtkArgs& a) {
   const StreamSummary s = read_stream(a.input, v);
   std::fprintf(stderr, "mpm-post: wrote %zu frame(s) and %s\n", entries.size(),
                (std::filesystem::path(dir) / (name + ".pvd")).string().c_str());
+  if (!bars.empty())
+    std::fprintf(stderr,
+                 "mpm-post: wrote %zu rebar frame(s) and %s (line cells: axial_stress, "
+                 "plastic_strain, eroded)\n",
+                 bars.size(),
+                 (std::filesystem::path(dir) / (name + "_rebar.pvd")).string().c_str());
   if (!grids.empty())
     std::fprintf(stderr, "mpm-post: wrote %zu graded grid(s) and %s (cell field 'level')\n",
                  grids.size(),
@@ -92,16 +112,23 @@ int post_render(const RenderArgs& a) {
   std::optional<Scene> scene;
   long index = 0;
   double best = 1e300;
+  bool chosen_now = false;  // the last frame read is the chosen one (its REBR record follows)
   StreamVisitor v;
   v.scene = [&](const std::string& t) { scene = scene_of(t, path); };
   v.frame = [&](Frame&& f) {
     const long k = index++;
+    chosen_now = false;
     if (at) {
       const double d = std::abs(f.time - *at);
-      if (d < best) best = d, chosen = std::move(f);
+      if (d < best) best = d, chosen = std::move(f), chosen_now = true;
     } else if (want < 0 || k == want) {
-      chosen = std::move(f);
+      chosen = std::move(f), chosen_now = true;
     }
+    if (chosen_now) o.rebar = RebarLines{};
+  };
+  v.rebar = [&](Frame&& e) {
+    if (chosen_now) o.rebar = rebar_lines(*chosen, e);
+    chosen_now = false;
   };
   const StreamSummary s = read_stream(path, v);
   if (!chosen) {

@@ -1,9 +1,12 @@
 #pragma once
 /// ParaView output and off-screen pictures of frames (mpm-post vtk, mpm-post render).
+#include <array>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "mpm/core/types.hpp"
 #include "mpm/post/symmetry.hpp"
 #include "mpm/stream/stream.hpp"
 
@@ -30,6 +33,21 @@ void write_vtu(const Frame& frame, int dim, const std::string& path);
 /// write_vtu (binary, zlib, under a temporary name). Throws IoError.
 void write_grid_vtu(const GridMesh& mesh, const std::string& path);
 
+/// The rebar of a frame: the elements of a REBR record between their node particles'
+/// positions in the frame (elements whose nodes the frame lacks are left out).
+struct RebarLines {
+  std::vector<Vec3> points;                         ///< m, the node particles used
+  std::vector<std::array<std::uint32_t, 2>> lines;  ///< points of each element
+  std::vector<double> sigma, eps_p;                 ///< Pa, accumulated plastic strain
+  std::vector<std::uint8_t> eroded;
+};
+RebarLines rebar_lines(const Frame& particles, const Frame& elements);
+
+/// Writes rebar as a .vtu of line cells with the cell fields "axial_stress" (Pa),
+/// "plastic_strain" and "eroded", and the field data of write_vtu. Throws IoError.
+void write_rebar_vtu(const RebarLines& rebar, double time, std::int64_t step,
+                     const std::string& path);
+
 /// Writes a ParaView collection (.pvd) listing (time in s, file name relative to the .pvd).
 /// Throws IoError when the file cannot be written.
 void write_pvd(const std::vector<std::pair<double, std::string>>& entries, const std::string& path);
@@ -53,6 +71,8 @@ struct RenderOptions {
   /// Mirror images drawn with each particle: the whole body of a quarter or half model; an
   /// axisymmetric frame's whole section through the axis (the plane x = 0). None: as it is.
   Symmetry symmetry;
+  /// Rebar drawn over the particles as lines (eroded elements left out); empty: none.
+  RebarLines rebar;
   /// "y = 0", "x = 2 mm": cut the body (with its images) at this plane, keep the side holding
   /// more particles and look square at the cut. Empty: no section.
   std::string section;

@@ -13,6 +13,7 @@
 #include "mpm/scene/scene.hpp"
 #include "mpm/solver/core.hpp"
 #include "mpm/solver/explicit/contact_fields.hpp"
+#include "mpm/solver/explicit/rebar.hpp"
 #include "mpm/solver/explicit/scatter.hpp"
 
 namespace mpm {
@@ -45,6 +46,13 @@ class ExplicitSolver : public SolverCore<GridT> {
   /// Force (N) on the first body of each [[contact]] pair from the second in the last step
   /// (per metre in plane strain, per radian in axisymmetry), in the order of Scene::contacts.
   const std::vector<Vec3>& contact_force() const { return contact_.force(); }
+  /// Takes the rebar's element table (rebar_elements.hpp; a model's REBR record) before the
+  /// first step: it stays the caller's and is updated in place; the first stable step then
+  /// includes the elements' (L / sqrt(E / rho)). Throws InputError for a table the scene
+  /// does not match.
+  void attach_rebar(ColumnStore& elements);
+  /// Rebar elements eroded so far (0 without rebar).
+  std::size_t eroded_elements() const { return rebar_sums_.eroded; }
   /// The state between steps beyond the particle columns (SolverCore's, the stable step and
   /// the split counters); restore on a solver built from the columns saved with it.
   void save_state(StateValues& s) const;
@@ -86,6 +94,7 @@ class ExplicitSolver : public SolverCore<GridT> {
   void update_stress(const std::vector<Vec<D>>& v_grad, Positions positions);
   void exchange_momentum(Exchange on);
   void split_particles() requires GridT::kGraded;
+  void rebar_forces();
 
   // The particle kernels' builds with and without contact.
   template <int F, bool C>
@@ -155,6 +164,11 @@ class ExplicitSolver : public SolverCore<GridT> {
                         const Vec<D>* v_c, double* N, ChunkSums& s, std::int64_t bin_key) const;
   void stress_block(const ParticleView<D>& p, PendingBlock& pb, StressScratch& scr,
                     ChunkSums& s) const;
+  /// A particle without stress in the stress pass: a rigid one advances with its own
+  /// velocity, a rebar node with the grid's (v_c: its bin's cached nodal velocities or null).
+  [[gnu::noinline, gnu::cold]] void move_unstressed(const ParticleView<D>& p, std::uint32_t i,
+                                                    std::int64_t bin_key, const std::int64_t* nodes,
+                                                    int nn, const Vec<D>* v_c, ChunkSums& s);
   template <bool C>
   void stress_chunk(const ParticleView<D>& p, int ch, const Vec<D>* vg_i, Positions positions,
                     bool remapped, ChunkSums& s);
@@ -176,6 +190,9 @@ class ExplicitSolver : public SolverCore<GridT> {
   Scheme scheme_;
   Scatter<GridT> scatter_;
   ContactFields<D> contact_;  ///< the bodies' own fields ([[contact]]); inactive without
+  RebarTruss<D> rebar_;       ///< truss elements ([[rebar]]); inactive without
+  RebarSums rebar_sums_;      ///< of the last element pass
+  long rebar_linked_ = -1;    ///< the sort the rebar's node indices were found after
   double cfl_, dt_max_;
   double stable_dt_ = 0;
   double leapfrog_kinetic_ = 0;  ///< sum m v(k-1/2).v(k+1/2) / 2 of the last step

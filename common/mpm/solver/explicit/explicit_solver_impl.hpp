@@ -17,6 +17,7 @@
 #include "mpm/solver/explicit/graded_split.hpp"
 #include "mpm/solver/explicit/grid_update.hpp"
 #include "mpm/solver/explicit/p2g.hpp"
+#include "mpm/solver/explicit/rebar_forces.hpp"
 #include "mpm/solver/explicit/stress.hpp"
 
 namespace mpm {
@@ -24,7 +25,8 @@ namespace mpm {
 template <Grid GridT>
 void ExplicitSolver<GridT>::step(double dt, double dt_pace) {
   dt_ = dt;
-  if (need_sort_) sort_particles();  // cell order; the grid window follows the material
+  if (need_sort_) sort_particles();     // cell order; the grid window follows the material
+  if (rebar_.active()) rebar_forces();  // truss elements: forces on their nodes (004, 3.4 step 4)
   const double internal_start = balance_.internal, kinetic_start = balance_.kinetic;
   switch (scheme_) {
     case Scheme::USF:                           // update stress first (004, section 3.4)
@@ -111,6 +113,7 @@ void ExplicitSolver<GridT>::save_state(StateValues& s) const {
   s.set("next_id", double(next_id_));
   s.set("splits", double(split_count_));
   s.set("split_wait", double(split_wait_));
+  if (rebar_.active()) s.set("rebar_energy", rebar_sums_.energy);  // in the balance's internal
 }
 
 template <Grid GridT>
@@ -121,12 +124,13 @@ void ExplicitSolver<GridT>::restore_state(const StateValues& s) {
   next_id_ = std::uint32_t(s.get("next_id"));
   split_count_ = long(s.get("splits"));
   split_wait_ = int(s.get("split_wait"));
+  if (rebar_.active()) rebar_sums_.energy = s.get("rebar_energy");
 }
 
 template <Grid GridT>
 std::size_t ExplicitSolver<GridT>::work_bytes() const {
   std::size_t b = grid_.nodes() * (sizeof(double) + 3 * sizeof(Vec<D>) + (has_rigid_ ? 1 : 0));
-  b += scatter_.bytes() + contact_.bytes();
+  b += scatter_.bytes() + contact_.bytes() + rebar_.bytes();
   b += binning_.bins().capacity() * sizeof(Bin) + binning_.chunks().capacity() * sizeof(Chunk);
   return b;
 }
@@ -147,7 +151,10 @@ void ExplicitSolver<GridT>::finish(std::vector<ChunkSums>& stats, int changed) {
   }
   if (changed & kStresses) {
     balance_.internal = total.internal;
-    stable_dt_ = std::min(dt_max_, cfl_ * total.dt_min);
+    double dt_min = total.dt_min;
+    if (rebar_.active())  // the truss elements' energy and step (rebar_forces.hpp)
+      balance_.internal += rebar_sums_.energy, dt_min = std::min(dt_min, rebar_sums_.dt_min);
+    stable_dt_ = std::min(dt_max_, cfl_ * dt_min);
   }
   if (changed & kPositions) {
     balance_.kinetic = total.kinetic;

@@ -93,7 +93,9 @@ auto ExplicitSolver<GridT>::scan_for_splits() -> SplitScan requires GridT::kGrad
         level[i] = std::uint8_t(std::max(1, grid_.level_at(p.x[i])));
         continue;
       }
-      if (grid_.in_finer(p.x[i], level[i])) scan.found[b].push_back(std::uint32_t(i));
+      // Rebar nodes are not split: their elements link them, not the grid (004, section 3.3).
+      if (grid_.in_finer(p.x[i], level[i]) && p.material[i] != kRebarNode)
+        scan.found[b].push_back(std::uint32_t(i));
       if (follow >= 0 && p.body[i] == follow) {
         mass[b] += p.m[i];
         moment[b] += p.m[i] * p.x[i];

@@ -52,6 +52,7 @@ void ExplicitSolver<GridT>::scatter_to_grid() {
       Vsigma = V * to_matrix(p.sigma[i]).template topLeftCorner<D, D>();
       if (axi) Vs_hoop_r = V * p.sigma[i][2] / p.x[i][0];
       if (p.f_ext) fb += p.f_ext[i];
+      if (p.f_rebar) fb += p.f_rebar[i];  // the rebar elements' force on a node (004, eq. 13)
     }
     for (int c = 0; c < nn; ++c) {
       Vec<D> df = Vec<D>::Zero();
@@ -161,6 +162,7 @@ void ExplicitSolver<GridT>::add_to_field(const ParticleView<D>& p, std::uint32_t
     const double Vs_hoop_r = axisymmetric_ ? V * p.sigma[i][2] / p.x[i][0] : 0.0;
     Vec<D> fb = m_p * gravity_;
     if (p.f_ext) fb += p.f_ext[i];
+    if (p.f_rebar) fb += p.f_rebar[i];
     for (int c = 0; c < nk; ++c) {
       Vec<D> df = N[c] * fb - Vsigma * G[c];         // (000, eqs. 4-5)
       if (axisymmetric_) df[0] -= Vs_hoop_r * N[c];  // hoop stress

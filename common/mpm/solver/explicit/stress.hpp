@@ -56,11 +56,8 @@ template <bool C>
     }
     const double h_cell = grid_.cell_size(bin.key);
     for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
-      if (rigid(i)) {  // no stress; advances with its own velocity
-        if (move) {
-          p.x[i] += dt * p.v[i];
-          track_move(p.x[i], i, bin.key, s);
-        }
+      if (p.material[i] >= kRebarNode) [[unlikely]] {  // rigid particles and rebar nodes
+        if (move) move_unstressed(p, i, bin.key, nodes, nn, C ? nullptr : v_c, s);
         continue;
       }
       const auto [key, xi, home, nk, nd] = locate_in_bin(bin.key, nodes, nn, p.x[i], other);
@@ -107,6 +104,32 @@ template <bool C>
     }
   }
   stress_block(p, pb, scr, s);
+}
+
+/// Rigid particles advance with their own velocity; rebar nodes carry no stress (their
+/// elements do: rebar_forces.hpp) and advance with the grid velocity (000, eq. 7), from their
+/// body's field with contact.
+template <Grid GridT>
+void ExplicitSolver<GridT>::move_unstressed(const ParticleView<D>& p, std::uint32_t i,
+                                            std::int64_t bin_key, const std::int64_t* nodes, int nn,
+                                            const Vec<D>* v_c, ChunkSums& s) {
+  if (rigid(i)) {
+    p.x[i] += dt_ * p.v[i];
+    track_move(p.x[i], i, bin_key, s);
+    return;
+  }
+  std::int64_t other[NMAX];
+  const auto [key, xi, home, nk, nd] = locate_in_bin(bin_key, nodes, nn, p.x[i], other);
+  double N[NMAX];
+  grid_.values(key, xi, N);
+  const Vec<D>* v_i = grid_.v.data();
+  if (contact_.active())
+    if (const int f = contact_.field_of(p.body[i])) v_i = contact_.field(f).v.data();
+  Vec<D> vbar = Vec<D>::Zero();
+  for (int c = 0; c < nk; ++c) vbar += N[c] * (home && v_c ? v_c[c] : v_i[nd[c]]);
+  p.x[i] += dt_ * vbar;  // (000, eq. 7)
+  s.add_motion(p, i);
+  track_move(p.x[i], i, bin_key, s);
 }
 
 /// The material update of the pending block (then empty), its internal energy and stable
