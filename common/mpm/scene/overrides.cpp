@@ -39,14 +39,17 @@ std::vector<std::string> key_parts(const std::string& key, const std::string& lo
   return parts;
 }
 
-/// The table of bodies.<name or index> or loads.<index> (parts[0] is "bodies" or "loads").
+/// The table of bodies.<name or index>, loads.<index> or contact.<index> (parts[0] is
+/// "bodies", "loads" or "contact").
 toml::table* select_body_or_load(toml::table& root, const std::vector<std::string>& parts,
                                  const std::string& loc) {
   const std::string& what = parts[0];
+  const std::string one = what == "bodies" ? "body" : what == "loads" ? "load" : "pair";
   if (parts.size() < 3) {
-    throw InputError(loc, what == "bodies"
-                              ? "expected bodies.<name or index>.<key>, e.g. bodies.bar.velocity"
-                              : "expected loads.<index>.<key>, e.g. loads.0.force");
+    throw InputError(
+        loc, what == "bodies"  ? "expected bodies.<name or index>.<key>, e.g. bodies.bar.velocity"
+             : what == "loads" ? "expected loads.<index>.<key>, e.g. loads.0.force"
+                               : "expected contact.<index>.<key>, e.g. contact.0.friction");
   }
   auto* arr = root.get_as<toml::array>(what);
   if (!arr) throw InputError(loc, "the scene has no [[" + what + "]] to change");
@@ -56,13 +59,13 @@ toml::table* select_body_or_load(toml::table& root, const std::vector<std::strin
     std::size_t index = 0;
     const auto [ptr, ec] = std::from_chars(sel.data(), sel.data() + sel.size(), index);
     if (ec != std::errc() || index >= arr->size()) {
-      throw InputError(loc, "no " + std::string(what == "bodies" ? "body" : "load") +
-                                " with index " + sel + " (the scene has " +
+      throw InputError(loc, "no " + one + " with index " + sel + " (the scene has " +
                                 std::to_string(arr->size()) + ", numbered from 0)");
     }
     body = arr->get(index);
-  } else if (what == "loads") {
-    throw InputError(loc, "loads are selected by index, e.g. loads.0.force");
+  } else if (what != "bodies") {
+    throw InputError(loc, what + " entries are selected by index, e.g. " + what + ".0." +
+                              (what == "loads" ? "force" : "friction"));
   } else {
     std::vector<std::string> known;
     for (auto& e : *arr) {
@@ -106,7 +109,7 @@ toml::table* holder(toml::table& root, const std::vector<std::string>& parts,
   toml::table* t = &root;
   std::size_t i = 0;
   std::string walked;
-  if ((parts[0] == "bodies" || parts[0] == "loads") && parts.size() > 1) {
+  if ((parts[0] == "bodies" || parts[0] == "loads" || parts[0] == "contact") && parts.size() > 1) {
     t = select_body_or_load(root, parts, loc);
     i = 2;
     walked = parts[0] + "." + parts[1];
