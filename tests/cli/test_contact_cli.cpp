@@ -59,6 +59,10 @@ TEST(ContactCli, BadContactInputExitsTwoNamingFileLineAndKey) {
        "bodies = [",
        {"contact.0.bodies", "itself"}},
       {"one.toml", "[[contact]]\nbodies = [\"lid\"]\n", "bodies = [", {"contact.0.bodies", "two"}},
+      {"normal.toml",
+       "[[contact]]\nbodies = [\"block\", \"lid\"]\nnormal = \"plate\"\n",
+       "normal",
+       {"contact.0.normal", "'block' or 'lid'", "got 'plate'"}},
       {"twice.toml",
        "[[contact]]\nbodies = [\"lid\", \"block\"]\n\n[[contact]]\nbodies = [\"block\", "
        "\"lid\"]\nfriction = 0.3\n",
@@ -82,6 +86,19 @@ TEST(ContactCli, BadContactInputExitsTwoNamingFileLineAndKey) {
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("contact.0"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("explicit"), std::string::npos) << r.err;
+  // A pair's keys are set by index from the command line (docs/scene.md), and they are
+  // checked as in the file.
+  EXPECT_EQ(run(prep + " " + good.string() +
+                    " --set contact.0.friction=0.2 --set contact.0.normal=lid -o /dev/null",
+                dir)
+                .status,
+            0);
+  r = run(prep + " " + good.string() + " --set contact.0.friction=-1 -o /dev/null", dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("contact.0.friction"), std::string::npos) << r.err;
+  r = run(prep + " " + good.string() + " --set contact.3.friction=0.2 -o /dev/null", dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("no pair with index 3"), std::string::npos) << r.err;
 }
 
 }  // namespace

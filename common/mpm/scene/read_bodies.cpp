@@ -452,11 +452,25 @@ void read_contacts(Reader& top, Scene& s) {
     const Origin o = doc.origin(e, array_origin);
     const auto* t = e.as_table();
     if (!t) throw InputError(doc.where(o, path), "expected a table ([[contact]]), " + got(e));
-    Reader r(doc, *t, path, o, {"bodies", "friction"});
+    Reader r(doc, *t, path, o, {"bodies", "friction", "normal"});
     ContactSpec c;
     c.loc = r.loc();
     std::tie(c.body_a, c.body_b) = read_contact_bodies(r, s);
     c.friction = r.number("friction", Bound::NonNegative).value_or(0.0);
+    if (const auto normal = r.string("normal")) {
+      const std::string &a = s.bodies[c.body_a].name, &b = s.bodies[c.body_b].name;
+      if (*normal == "steeper")
+        c.normal = ContactSpec::Normal::Steeper;
+      else if (*normal == "average")
+        c.normal = ContactSpec::Normal::Average;
+      else if (*normal == a)
+        c.normal = ContactSpec::Normal::BodyA;
+      else if (*normal == b)
+        c.normal = ContactSpec::Normal::BodyB;
+      else
+        r.fail("normal", "expected \"steeper\", \"average\" or one body of the pair ('" + a +
+                             "' or '" + b + "'), got '" + *normal + "'");
+    }
     for (const auto& other : s.contacts)
       if (std::minmax(other.body_a, other.body_b) == std::minmax(c.body_a, c.body_b))
         r.fail("bodies", "the pair '" + s.bodies[c.body_a].name + "', '" + s.bodies[c.body_b].name +

@@ -184,7 +184,11 @@ struct LoadSpec {
 struct ContactSpec {
   int body_a = -1, body_b = -1;  ///< indices into Scene::bodies, as the pair names them
   double friction = 0;           ///< Coulomb coefficient, >= 0; 0 = frictionless
-  SourceLoc loc;                 ///< key "contact.<index>"
+  /// Where the contact normal comes from at a node: the steeper of the two mass gradients,
+  /// their difference (an average), or one body's (body_a or body_b: a smooth, hard
+  /// penetrator's surface against a damaged target's ragged one).
+  enum class Normal { Steeper, Average, BodyA, BodyB } normal = Normal::Steeper;
+  SourceLoc loc;  ///< key "contact.<index>"
 };
 
 /// A refined box of a graded grid (004, section 3.1): its cells are cell_size / 2^(level - 1)

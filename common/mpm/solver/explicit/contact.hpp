@@ -14,7 +14,10 @@
 // sticking impulse): the exchange itself never adds energy. n is the mass gradient
 // sum_p m_p grad N_i(x_p) of the field where it is steeper (out of a, or minus b's): at a
 // corner of one body on a face of the other that is the face's normal, where an average
-// would tilt it and push a frictionless block along the face.
+// would tilt it and push a frictionless block along the face. A pair may take the normal from
+// one body instead (`normal = "<body>"`: a smooth penetrator's surface, whose normal a
+// damaged, ragged target would tilt, dragging a frictionless shank through its hole) or from
+// the difference of the two gradients (`normal = "average"`).
 // Energy is gained when the velocities the stress sees and those the particles carry
 // disagree (measured: two bars rebounding with 13% more energy, friction 13% too weak), so
 // the first exchange of a step decides which pairs touch at each node and the second applies
@@ -105,7 +108,12 @@ void ExplicitSolver<GridT>::exchange_momentum(Exchange on) {
           } else {
             const Vec<D>& g_a = g_f[a][i];
             const Vec<D>& g_b = g_f[b][i];
-            Vec<D> nrm = g_a.squaredNorm() >= g_b.squaredNorm() ? g_a : Vec<D>(-g_b);
+            const int from = contact_.normal_from(a, b);
+            Vec<D> nrm = from == a   ? g_a
+                         : from == b ? Vec<D>(-g_b)
+                         : from == ContactFields<D>::kAverage
+                             ? Vec<D>(g_a - g_b)
+                             : (g_a.squaredNorm() >= g_b.squaredNorm() ? g_a : Vec<D>(-g_b));
             const double len = nrm.norm();
             if (!(len > 0)) continue;
             nrm /= len;

@@ -46,10 +46,16 @@ class ContactFields {
     const int F = field_count();
     friction_.assign(std::size_t(F * F), -1.0);
     pair_.assign(std::size_t(F * F), -1);
+    normal_.assign(std::size_t(F * F), kSteeper);
     for (std::size_t k = 0; k < scene.contacts.size(); ++k) {
       const ContactSpec& c = scene.contacts[k];
       const int a = field_of_body_[c.body_a], b = field_of_body_[c.body_b];
       friction_[a * F + b] = friction_[b * F + a] = c.friction;
+      using N = ContactSpec::Normal;
+      const int own = c.normal == N::BodyA ? a : c.normal == N::BodyB ? b : -1;
+      normal_[a * F + b] = normal_[b * F + a] = own >= 0                 ? own
+                                                : c.normal == N::Average ? kAverage
+                                                                         : kSteeper;
       pair_[std::min(a, b) * F + std::max(a, b)] = int(k);
       sign_.push_back(a < b ? 1.0 : -1.0);
     }
@@ -66,6 +72,10 @@ class ContactFields {
   const Field& field(int f) const { return fields_[f - 1]; }
   /// Coulomb coefficient between fields a and b; negative: not a contact pair (they stick).
   double friction(int a, int b) const { return friction_[a * field_count() + b]; }
+  /// Where the normal between fields a and b comes from: kSteeper (the steeper mass gradient),
+  /// kAverage (the difference of the two), or a field (that field's gradient).
+  static constexpr int kSteeper = -1, kAverage = -2;
+  int normal_from(int a, int b) const { return normal_[a * field_count() + b]; }
   /// Index of the [[contact]] pair of fields a < b, or -1.
   int pair(int a, int b) const { return pair_[a * field_count() + b]; }
   /// +1 when the first body the pair names has the lower field, else -1: the force on it
@@ -116,6 +126,7 @@ class ContactFields {
   std::vector<Field> fields_;
   std::vector<std::uint8_t> field_of_body_;
   std::vector<double> friction_;
+  std::vector<int> normal_;
   std::vector<int> pair_;
   std::vector<double> sign_;
   std::vector<Vec3> force_;
