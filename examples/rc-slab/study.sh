@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# V5 study: the four striking speeds of 004 Table 5 at the level-1 cell CELL (level 2 half of
+# it), and 749 m/s at each cell of CELLS (the resolution study), one run after the other; the
+# residual velocity (mpm-post residual), steps, wall time and throughput (mpm-run --stats) of
+# each go to study/table.md (table.py).
+# Usage: ./study.sh BUILD_DIR THREADS "434 606 749 1058" CELL "16mm 10mm 8mm"
+set -euo pipefail
+cd "$(dirname "$0")"
+bin=$1 threads=$2 speeds=$3 cell=$4 cells=$5
+mkdir -p study
+# 004 Table 5's end times.
+end_time() { case $1 in 434) echo 2ms ;; 606) echo 0.6ms ;; 749) echo 0.5ms ;; 1058) echo 0.3ms ;; *) echo 0.5ms ;; esac; }
+cases=()
+for v in $speeds; do cases+=("$cell:$v"); done
+for c in $cells; do
+  [ "$c" = "$cell" ] && [[ " $speeds " == *" 749 "* ]] && continue
+  cases+=("$c:749")
+done
+for cv in "${cases[@]}"; do
+  c=${cv%%:*} v=${cv##*:}
+  name=c${c%mm}_$v
+  echo "running $name ($(date +%H:%M:%S)) ..." >&2
+  "$bin/mpm-prep/mpm-prep" scene.toml --set grid.cell_size="$c" \
+    --set "bodies.projectile.velocity=0 0 -$v m/s" --set "solver.end_time=$(end_time "$v")" \
+    --set "scene.title=V5 $v m/s, level 1 $c" -o study/$name.model 2> study/prep_$name.log
+  status=0
+  "$bin/mpm-run/mpm-run" study/$name.model -o study/$name.mpm --threads "$threads" --stats \
+    --progress none 2> study/run_$name.log || status=$?
+  echo "$status" > study/status_$name.txt
+  rm -f study/$name.model
+  "$bin/mpm-post/mpm-post" residual study/$name.mpm --body projectile --target slab --json \
+    > study/residual_$name.json 2> study/residual_$name.log || true
+  "$bin/mpm-post/mpm-post" render study/$name.mpm -o study/damage_$name.png --view symmetry \
+    --field damage --size 900x700 \
+    --title "V5 at $v m/s, $c / level 2 half: damage at y = 0, rebar in red" || true
+done
+python3 table.py study
+cat study/table.md
