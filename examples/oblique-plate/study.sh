@@ -3,13 +3,18 @@
 # over the path) and on the uniform 1 mm grid, one run after the other on the same machine; the
 # residual velocity (mpm-post residual), steps, wall time and throughput (mpm-run --stats) of
 # each go to study/table.md (table.py).
-# Usage: ./study.sh BUILD_DIR THREADS "446 575 730" "graded uniform"
+# Usage: ./study.sh BUILD_DIR THREADS "446 575 730" "graded uniform" [END_TIME [DIR]]
+# END_TIME (e.g. 60us) cuts every run short (a cost comparison, not a residual velocity); DIR
+# is the output directory (default study).
 set -euo pipefail
 cd "$(dirname "$0")"
-bin=$1 threads=$2 speeds=$3 grids=$4
-mkdir -p study
+bin=$1 threads=$2 speeds=$3 grids=$4 end=${5:-} study=${6:-study}
+mkdir -p "$study"
 # 004 Table 9's end times; the rod flies along (0, -sin 30, -cos 30).
-end_time() { case $1 in 446) echo 0.4ms ;; 575) echo 0.3ms ;; 730) echo 0.21ms ;; *) echo 0.3ms ;; esac; }
+end_time() {
+  if [ -n "$end" ]; then echo "$end"; return; fi
+  case $1 in 446) echo 0.4ms ;; 575) echo 0.3ms ;; 730) echo 0.21ms ;; *) echo 0.3ms ;; esac
+}
 for v in $speeds; do
   vel=$(python3 -c "import math; v=$v; print(f'0 {-v*0.5:.4f} {-v*math.cos(math.pi/6):.4f} m/s')")
   for g in $grids; do
@@ -22,20 +27,20 @@ for v in $speeds; do
     echo "running $name ($(date +%H:%M:%S)) ..." >&2
     "$bin/mpm-prep/mpm-prep" scene.toml "${grid[@]}" --set "bodies.projectile.velocity=$vel" \
       --set "solver.end_time=$(end_time "$v")" --set "scene.title=V6 $v m/s, $g" \
-      -o study/$name.model 2> study/prep_$name.log
+      -o "$study"/$name.model 2> "$study"/prep_$name.log
     status=0
-    "$bin/mpm-run/mpm-run" study/$name.model -o study/$name.mpm --threads "$threads" --stats \
-      --progress none 2> study/run_$name.log || status=$?
-    echo "$status" > study/status_$name.txt
-    rm -f study/$name.model
-    "$bin/mpm-post/mpm-post" residual study/$name.mpm --body projectile --target plate --json \
-      > study/residual_$name.json 2> study/residual_$name.log || true
+    "$bin/mpm-run/mpm-run" "$study"/$name.model -o "$study"/$name.mpm --threads "$threads" --stats \
+      --progress none 2> "$study"/run_$name.log || status=$?
+    echo "$status" > "$study"/status_$name.txt
+    rm -f "$study"/$name.model
+    "$bin/mpm-post/mpm-post" residual "$study"/$name.mpm --body projectile --target plate --json \
+      > "$study"/residual_$name.json 2> "$study"/residual_$name.log || true
     if [ "$g" = graded ]; then
-      "$bin/mpm-post/mpm-post" render study/$name.mpm -o study/section_$v.png --view symmetry \
+      "$bin/mpm-post/mpm-post" render "$study"/$name.mpm -o "$study"/section_$v.png --view symmetry \
         --field eps_p --size 900x700 \
         --title "V6 at $v m/s, graded 2 mm / 1 mm: section through the path (x = 0)" || true
     fi
   done
 done
-python3 table.py study
-cat study/table.md
+python3 table.py "$study"
+cat "$study/table.md"

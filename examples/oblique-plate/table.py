@@ -83,6 +83,9 @@ def main():
             err = f"{100 * (vr - EXPERIMENT[v]) / EXPERIMENT[v]:+.1f}%" if vr is not None else "-"
             seed = SEED_GRADED[v] if g == "graded" else SEED_UNIFORM[v]
             note = "" if c.get("when") == "tail out" else " (end, tail in plate)"
+            if c.get("when") != "tail out" and c.get("t_end_us", 1e9) < 150:
+                note = f" (run cut at {c['t_end_us']:.0f} us: cost only)"
+                err = "-"
             if c.get("status"):
                 note += f" (mpm-run exit {c['status']})"
             lines.append(
