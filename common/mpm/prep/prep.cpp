@@ -173,24 +173,51 @@ void print_grid(const Scene& scene, const Lattice& lattice, const GradedModel* g
   }
 }
 
-/// The summary's table of bodies; returns the particles in all.
-std::size_t print_bodies(const Scene& scene, const std::vector<BodyReport>& report) {
+/// The mirror images a body's particles stand for: 2 for each slip face of the domain through
+/// the middle of the body's box (the symmetry plane of a half or quarter model), else 1.
+int mirror_images(const Scene& scene, const Lattice& lattice, const Vec3& lo, const Vec3& hi) {
+  if (scene.axisymmetric) return 1;  // its mass is per radian already, of r >= 0
+  int images = 1;
+  for (int f = 0; f < 2 * scene.dimension; ++f) {
+    if (scene.boundary.face[f] != BoundaryType::Slip) continue;
+    const int a = f / 2;
+    const double plane = f % 2 ? lattice.max()[a] : lattice.origin[a];
+    if (std::abs(plane - 0.5 * (lo[a] + hi[a])) <= 1e-6 * (hi[a] - lo[a])) images *= 2;
+  }
+  return images;
+}
+
+/// The summary's table of bodies; returns the particles in all. A body cut through its middle
+/// by symmetry planes is compared whole: its mass times its mirror images against the whole
+/// body's exact mass (a half model's plate is not 50% short).
+std::size_t print_bodies(const Scene& scene, const std::vector<BodyReport>& report,
+                         const Lattice& lattice, const BodyBoxes& boxes) {
   std::fprintf(stderr, "  %-14s %-12s %12s %10s %14s %14s %8s\n", "body", "material", "particles",
                "spacing", "mass kg", "exact kg", "error");
   std::size_t total = 0;
+  bool mirrored = false;
   const std::size_t shown = report.size() > 24 ? 12 : report.size();  // a table of grains: its head
   for (std::size_t b = 0; b < report.size(); ++b) {
     const BodyReport& r = report[b];
     total += r.particles;
     if (b == shown) std::fprintf(stderr, "  ... %zu bodies more\n", report.size() - shown);
     if (b >= shown) continue;
+    const int images =
+        b < boxes.lo.size() ? mirror_images(scene, lattice, boxes.lo[b], boxes.hi[b]) : 1;
+    const double mass = r.mass * images;
+    const std::string name = images > 1 ? r.name + " (x" + std::to_string(images) + ")" : r.name;
+    mirrored = mirrored || images > 1;
     std::fprintf(
-        stderr, "  %-14s %-12s %12zu %7s mm %14.6g %14.6g %7.2f%%\n", r.name.c_str(),
+        stderr, "  %-14s %-12s %12zu %7s mm %14.6g %14.6g %7.2f%%\n", name.c_str(),
         scene.bodies[b].rigid ? "(rigid)" : scene.materials[scene.bodies[b].material].name.c_str(),
-        r.particles, mm(r.spacing).c_str(), r.mass, r.exact_mass,
-        r.exact_mass > 0 ? 100.0 * (r.mass - r.exact_mass) / r.exact_mass : 0.0);
+        r.particles, mm(r.spacing).c_str(), mass, r.exact_mass,
+        r.exact_mass > 0 ? 100.0 * (mass - r.exact_mass) / r.exact_mass : 0.0);
   }
   std::fprintf(stderr, "  %-14s %-12s %12zu\n", "total", "", total);
+  if (mirrored)
+    std::fprintf(stderr,
+                 "  (x2, x4: the body is cut through its middle by symmetry planes (slip faces); "
+                 "its mass is the model's times its mirror images, against the whole body)\n");
   return total;
 }
 
@@ -376,7 +403,7 @@ int prepare_model(const PrepOptions& opt) {
   if (!rebar_report.empty()) rebar_time_step(scene, rebar_report, estimates);
   if (!opt.quiet) {
     print_grid(scene, lattice, graded_grid);
-    const std::size_t total = print_bodies(scene, report);
+    const std::size_t total = print_bodies(scene, report, lattice, boxes);
     if (!rebar_report.empty()) print_rebar(scene, rebar_report);
     print_materials(scene, graded_grid ? graded_grid->h_min : lattice.h);
     print_estimates(scene, estimates, total);
