@@ -202,8 +202,7 @@ std::size_t print_bodies(const Scene& scene, const std::vector<BodyReport>& repo
     total += r.particles;
     if (b == shown) std::fprintf(stderr, "  ... %zu bodies more\n", report.size() - shown);
     if (b >= shown) continue;
-    const int images =
-        b < boxes.lo.size() ? mirror_images(scene, lattice, boxes.lo[b], boxes.hi[b]) : 1;
+    const int images = mirror_images(scene, lattice, boxes.lo[b], boxes.hi[b]);
     const double mass = r.mass * images;
     const std::string name = images > 1 ? r.name + " (x" + std::to_string(images) + ")" : r.name;
     mirrored = mirrored || images > 1;

@@ -39,21 +39,36 @@ std::vector<std::string> key_parts(const std::string& key, const std::string& lo
   return parts;
 }
 
-/// The table of bodies.<name or index>, loads.<index>, contact.<index> or rebar.<index>
-/// (parts[0] is "bodies", "loads", "contact" or "rebar").
+/// The arrays of tables whose entries --set selects: by index, bodies also by name; what one
+/// entry is called in messages, and a key for their examples.
+struct Selectable {
+  const char* array;
+  const char* one;
+  const char* example_key;
+};
+constexpr Selectable kSelectable[] = {{"bodies", "body", "velocity"},
+                                      {"loads", "load", "force"},
+                                      {"contact", "pair", "friction"},
+                                      {"rebar", "[[rebar]] entry", "diameter"}};
+
+/// The entry of kSelectable for an override's first part, or nullptr.
+const Selectable* selectable(const std::string& what) {
+  for (const Selectable& s : kSelectable)
+    if (what == s.array) return &s;
+  return nullptr;
+}
+
+/// The table of bodies.<name or index>, or of loads, contact or rebar .<index> (parts[0] is
+/// one of kSelectable's arrays).
 toml::table* select_body_or_load(toml::table& root, const std::vector<std::string>& parts,
                                  const std::string& loc) {
   const std::string& what = parts[0];
-  const std::string one = what == "bodies"    ? "body"
-                          : what == "loads"   ? "load"
-                          : what == "contact" ? "pair"
-                                              : "[[rebar]] entry";
+  const Selectable& sel_of = *selectable(what);
+  const std::string example = what + ".0." + sel_of.example_key;
   if (parts.size() < 3) {
-    throw InputError(
-        loc, what == "bodies"  ? "expected bodies.<name or index>.<key>, e.g. bodies.bar.velocity"
-             : what == "loads" ? "expected loads.<index>.<key>, e.g. loads.0.force"
-             : what == "rebar" ? "expected rebar.<index>.<key>, e.g. rebar.0.diameter"
-                               : "expected contact.<index>.<key>, e.g. contact.0.friction");
+    throw InputError(loc, what == "bodies"
+                              ? "expected bodies.<name or index>.<key>, e.g. bodies.bar.velocity"
+                              : "expected " + what + ".<index>.<key>, e.g. " + example);
   }
   auto* arr = root.get_as<toml::array>(what);
   if (!arr) throw InputError(loc, "the scene has no [[" + what + "]] to change");
@@ -63,15 +78,13 @@ toml::table* select_body_or_load(toml::table& root, const std::vector<std::strin
     std::size_t index = 0;
     const auto [ptr, ec] = std::from_chars(sel.data(), sel.data() + sel.size(), index);
     if (ec != std::errc() || index >= arr->size()) {
-      throw InputError(loc, "no " + one + " with index " + sel + " (the scene has " +
-                                std::to_string(arr->size()) + ", numbered from 0)");
+      throw InputError(loc, "no " + std::string(sel_of.one) + " with index " + sel +
+                                " (the scene has " + std::to_string(arr->size()) +
+                                ", numbered from 0)");
     }
     body = arr->get(index);
   } else if (what != "bodies") {
-    throw InputError(loc, what + " entries are selected by index, e.g. " + what + ".0." +
-                              (what == "loads"   ? "force"
-                               : what == "rebar" ? "diameter"
-                                                 : "friction"));
+    throw InputError(loc, what + " entries are selected by index, e.g. " + example);
   } else {
     std::vector<std::string> known;
     for (auto& e : *arr) {
@@ -108,16 +121,14 @@ toml::table* select_level(toml::table& root, const std::vector<std::string>& par
 }
 
 /// The table that holds the key's last part: from the root, or from the selected entry of
-/// [[bodies]], [[loads]] or [[grid.levels]], through the tables of the path (created when
-/// missing, as coming from the override `key`).
+/// [[bodies]], [[loads]], [[contact]], [[rebar]] or [[grid.levels]], through the tables of the path
+/// (created when missing, as coming from the override `key`).
 toml::table* holder(toml::table& root, const std::vector<std::string>& parts,
                     const std::string& key, const std::string& loc, Doc& doc) {
   toml::table* t = &root;
   std::size_t i = 0;
   std::string walked;
-  if ((parts[0] == "bodies" || parts[0] == "loads" || parts[0] == "contact" ||
-       parts[0] == "rebar") &&
-      parts.size() > 1) {
+  if (selectable(parts[0]) && parts.size() > 1) {
     t = select_body_or_load(root, parts, loc);
     i = 2;
     walked = parts[0] + "." + parts[1];
