@@ -33,10 +33,12 @@ def taylor_cases():
     the 3D model at two cell sizes."""
     out = []
 
-    def add(h, ppc=2, scheme="MUSL", cfl=0.5, graded=False, model="axi"):
+    def add(h, ppc=2, scheme="MUSL", cfl=0.5, graded=False, model="axi", shape="linear"):
         scene = "taylor_axi.toml" if model == "axi" else "../taylor-bar/scene.toml"
         sets = [f"grid.cell_size={h} mm", f"bodies.bar.particles_per_cell={ppc}",
                 f"solver.scheme={scheme}", f"solver.cfl={cfl}", "output.frames=1"]
+        if shape != "linear":
+            sets.append(f"grid.shape={shape}")
         grid = "uniform"
         if graded:  # level 2 (h / 2) over the 3.8 mm next to the wall, out to r = 7.6 mm
             grid = "graded"
@@ -44,8 +46,10 @@ def taylor_cases():
             label_h = f"{h}/{h / 2:g}"
         else:
             label_h = f"{h}"
-        knobs = dict(model=model, cell_mm=label_h, ppc=ppc, scheme=scheme, cfl=cfl, grid=grid)
+        knobs = dict(model=model, cell_mm=label_h, ppc=ppc, scheme=scheme, cfl=cfl, grid=grid,
+                     shape=shape)
         label = f"{model} h={label_h} ppc={ppc} {scheme} cfl={cfl}" + (" graded" if graded else "")
+        label += f" {shape}" if shape != "linear" else ""
         out.append((label, scene, sets, knobs))
 
     for h in (0.76, 0.38, 0.19, 0.095):  # cell size (2 x 2 particles per cell, MUSL, cfl 0.5)
@@ -64,6 +68,9 @@ def taylor_cases():
     add(0.19, graded=True)
     add(0.76, model="3d")  # 3D against axisymmetric
     add(0.38, model="3d")
+    for h in (0.76, 0.38):  # B-spline weights, with MUSL and APIC (3D: no axisymmetric B-splines)
+        for scheme in ("MUSL", "APIC"):
+            add(h, scheme=scheme, model="3d", shape="bspline")
     return out
 
 
@@ -76,7 +83,7 @@ def rod_cases():
     graded grid (level 2 over the middle 40 mm, as V1)."""
     out = []
 
-    def add(h, ppc=2, scheme="MUSL", cfl=0.5, graded=False):
+    def add(h, ppc=2, scheme="MUSL", cfl=0.5, graded=False, shape="linear"):
         s = h / ppc  # particle spacing: the load acts on the last layer of particles
         half = h / 2
         force = ROD_S0 * (h * 1e-3) ** 2
@@ -86,6 +93,8 @@ def rod_cases():
                 f'max = "100 {half} {half} mm" }}',
                 f'grid.domain={{ min = "0 {-half} {-half} mm", max = "{100 + h} {half} {half} mm" }}',
                 f"solver.scheme={scheme}", f"solver.cfl={cfl}"]
+        if shape != "linear":
+            sets.append(f"grid.shape={shape}")
         grid = "uniform"
         label_h = f"{h}"
         if graded:
@@ -93,8 +102,10 @@ def rod_cases():
             label_h = f"{h}/{h / 2:g}"
             sets.append(f'grid.levels=[{{ level = 2, min = "30 {-half} {-half} mm", '
                         f'max = "70 {half} {half} mm" }}]')
-        knobs = dict(model="3d", cell_mm=label_h, ppc=ppc, scheme=scheme, cfl=cfl, grid=grid)
+        knobs = dict(model="3d", cell_mm=label_h, ppc=ppc, scheme=scheme, cfl=cfl, grid=grid,
+                     shape=shape)
         label = f"h={label_h} ppc={ppc} {scheme} cfl={cfl}" + (" graded" if graded else "")
+        label += f" {shape}" if shape != "linear" else ""
         out.append((label, "rod.toml", sets, knobs))
 
     for h in (1.0, 0.5, 0.25, 0.125, 0.0625):
@@ -109,6 +120,9 @@ def rod_cases():
     add(0.125, cfl=0.9)
     add(0.5, graded=True)
     add(0.25, graded=True)
+    for h in (0.5, 0.25, 0.125):  # B-spline weights, with MUSL and APIC
+        for scheme in ("MUSL", "APIC"):
+            add(h, scheme=scheme, shape="bspline")
     return out
 
 
@@ -192,7 +206,8 @@ def rod_error(bin_dir, result, out_dir, tag):
     return dict(error_pct=100 * statistics.mean(l1s), L2_pct=100 * statistics.mean(l2s))
 
 
-FIELDS = ["problem", "label", "model", "cell_mm", "ppc", "scheme", "cfl", "grid", "status",
+FIELDS = ["problem", "label", "model", "cell_mm", "ppc", "scheme", "cfl", "grid", "shape",
+          "status",
           "error_pct", "L_mm", "D_mm", "L_err_pct", "D_err_pct", "L_centres_mm", "D_centres_mm",
           "L2_pct", "particles", "steps", "particle_steps", "wall_s", "cpu_s", "peak_mb",
           "repeats", "wall_runs_s", "ns_per_particle_step"]

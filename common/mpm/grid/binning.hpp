@@ -115,7 +115,13 @@ void Binning::sort(ColumnStore& cols, GridT& grid, const std::vector<std::uint32
   chunks_.clear();
   if (bins_.empty()) return;
   const int layers = grid.layers();
-  const int target = std::max(1, std::min(target_chunks, layers));
+  // A stencil spanning L node layers reaches L - 1 layers past its own: chunks of at least
+  // that many layers keep two chunks of one colour from sharing a node.
+  constexpr int kMinLayers = [] {
+    if constexpr (requires { GridT::kStencilLayers; }) return GridT::kStencilLayers - 1;
+    return 1;
+  }();
+  const int target = std::max(1, std::min(target_chunks, layers / kMinLayers));
   const double per_chunk = double(kept) / target;
   Chunk cur;
   cur.bin_begin = 0;
@@ -124,8 +130,9 @@ void Binning::sort(ColumnStore& cols, GridT& grid, const std::vector<std::uint32
   for (std::uint32_t b = 0; b < bins_.size(); ++b) {
     const int layer = grid.layer(bins_[b].key);
     // Close the current chunk at a layer boundary once it holds its share.
-    if (layer != grid.layer(bins_[cur.bin_begin].key) && b > cur.bin_begin &&
-        grid.layer(bins_[b - 1].key) != layer &&
+    const bool apart = kMinLayers == 1 ? layer != grid.layer(bins_[cur.bin_begin].key)
+                                       : layer - cur.layer_begin >= kMinLayers;
+    if (apart && b > cur.bin_begin && grid.layer(bins_[b - 1].key) != layer &&
         double(done) >= per_chunk * double(chunks_.size() + 1) &&
         int(chunks_.size()) + 1 < target) {
       cur.bin_end = b;

@@ -33,8 +33,8 @@ int CellLattice<D>::particle_box(const Vec<D>* x, std::size_t n, int margin, IVe
 }
 
 template <int D>
-UniformGrid<D>::UniformGrid(const Lattice& lattice, const BoundarySpec& boundary)
-    : Base(lattice), GridNodes<D>(boundary), lattice_(lattice) {
+UniformGrid<D>::UniformGrid(const Lattice& lattice, const BoundarySpec& boundary, int ghost)
+    : Base(lattice), GridNodes<D>(boundary), lattice_(lattice), ghost_(ghost) {
   for (int a = 0; a < D; ++a) {
     lo_[a] = 0;
     hi_[a] = cells_[a] - 1;
@@ -63,11 +63,14 @@ void UniformGrid<D>::fit(const Vec<D>* x, std::size_t n, int margin) {
   }
   this->resize_nodes(std::size_t(s));  // the arrays now mean other nodes
   // Nodes on constrained domain faces that the window reaches.
-  this->collect_face_nodes(cells_, lo_, nodes_, [&](const IVec<D>& k) {
-    std::int64_t idx = 0;
-    for (int b = 0; b < D; ++b) idx += std::int64_t(k[b]) * stride_[b];
-    return idx;
-  });
+  this->collect_face_nodes(
+      cells_, lo_, nodes_,
+      [&](const IVec<D>& k) {
+        std::int64_t idx = 0;
+        for (int b = 0; b < D; ++b) idx += std::int64_t(k[b]) * stride_[b];
+        return idx;
+      },
+      ghost_);
 }
 
 template <int D>

@@ -116,30 +116,40 @@ class GridNodes {
   /// box whose lowest node is the global node `lo` and which has `count` nodes along each axis;
   /// index(k) gives the node of the box's local node k, or -1 when there is none. Faces in
   /// order, then the other axes' nodes with the lower axis fastest.
+  /// With `ghost` layers of nodes outside the domain (a lattice widened by that many cells on
+  /// every side: the B-spline grid), a face is the node plane `ghost` in from the lattice's
+  /// edge, and the ghost planes beyond it are held with it.
   template <class Index>
   void collect_face_nodes(const IVec<D>& cells, const IVec<D>& lo, const IVec<D>& count,
-                          Index&& index) {
+                          Index&& index, int ghost = 0) {
     fixed_.clear();
     slip_.clear();
     for (int face = 0; face < 2 * D; ++face) {
       const BoundaryType type = boundary_.face[face];
       if (type == BoundaryType::Free) continue;
       const int axis = face / 2;
-      const int local = ((face % 2 == 0) ? 0 : cells[axis]) - lo[axis];
-      if (local < 0 || local >= count[axis]) continue;
-      IVec<D> k = IVec<D>::Zero();
-      k[axis] = local;
-      const int other0 = axis == 0 ? 1 : 0;
-      const int other1 = D == 3 ? (axis == 2 ? 1 : 2) : -1;
-      const int n0 = count[other0], n1 = other1 >= 0 ? count[other1] : 1;
-      for (int j = 0; j < n1; ++j)
-        for (int i = 0; i < n0; ++i) {
-          k[other0] = i;
-          if (other1 >= 0) k[other1] = j;
-          const std::int64_t node = index(k);
-          if (node >= 0) (type == BoundaryType::Fixed ? fixed_ : slip_).push_back({node, face});
-        }
+      for (int g = 0; g <= ghost; ++g) {
+        const int plane = (face % 2 == 0) ? g : cells[axis] - g;
+        collect_plane(face, axis, plane - lo[axis], count, type, index);
+      }
     }
+  }
+  template <class Index>
+  void collect_plane(int face, int axis, int local, const IVec<D>& count, BoundaryType type,
+                     Index& index) {
+    if (local < 0 || local >= count[axis]) return;
+    IVec<D> k = IVec<D>::Zero();
+    k[axis] = local;
+    const int other0 = axis == 0 ? 1 : 0;
+    const int other1 = D == 3 ? (axis == 2 ? 1 : 2) : -1;
+    const int n0 = count[other0], n1 = other1 >= 0 ? count[other1] : 1;
+    for (int j = 0; j < n1; ++j)
+      for (int i = 0; i < n0; ++i) {
+        k[other0] = i;
+        if (other1 >= 0) k[other1] = j;
+        const std::int64_t node = index(k);
+        if (node >= 0) (type == BoundaryType::Fixed ? fixed_ : slip_).push_back({node, face});
+      }
   }
 
   BoundarySpec boundary_;
@@ -182,6 +192,17 @@ class CellLattice {
     shape_functions<D>(xi, inv_h_, N, G);
   }
   void values(std::int64_t, const Vec<D>& xi, double* N) const { shape_values<D>(xi, N); }
+  /// x_i - x_p of a cell's corners, in cells (APIC's affine momentum, p2g).
+  void offsets(std::int64_t, const Vec<D>& xi, Vec<D>* d) const {
+    for (int c = 0; c < kCorners<D>; ++c)
+      for (int a = 0; a < D; ++a) d[c][a] = double((c >> a) & 1) - xi[a];
+  }
+  /// APIC's C_p = sum_i v_i W_i^T: W = B-to-C weights, here the gradients (for multilinear
+  /// weights D_p^-1 N (x_i - x_p) = grad N: Jiang et al. 2015).
+  void affine_weights(std::int64_t, const Vec<D>&, const double*, const Vec<D>* G,
+                      Vec<D>* W) const {
+    for (int c = 0; c < kCorners<D>; ++c) W[c] = G[c];
+  }
 
  protected:
   /// The cells [lo, hi] of n particles widened by `margin` cells, clamped to the domain; returns
@@ -233,6 +254,8 @@ concept Grid = requires(G& g, const G& cg, const Vec<G::kDim>* xs, std::size_t n
 template <int D>
 class UniformGrid : public CellLattice<D>, public GridNodes<D> {
   using Base = CellLattice<D>;
+
+ protected:
   using Base::cells_;
 
  public:
@@ -243,7 +266,10 @@ class UniformGrid : public CellLattice<D>, public GridNodes<D> {
   static constexpr bool kFixedNodes = true;
   static constexpr bool kGraded = false;  ///< no levels, no particle splitting
 
-  UniformGrid(const Lattice& lattice, const BoundarySpec& boundary);
+  /// `ghost`: layers of cells the lattice has outside the domain on every side (0; the
+  /// B-spline grid builds on a lattice widened by 1), so that the domain faces lie `ghost`
+  /// nodes in.
+  UniformGrid(const Lattice& lattice, const BoundarySpec& boundary, int ghost = 0);
 
   /// Fits the window to the cells of n particles (their bounding box widened by `margin`
   /// cells, clamped to the domain), chooses the slab axis (the longest), and sizes the node
@@ -299,8 +325,9 @@ class UniformGrid : public CellLattice<D>, public GridNodes<D> {
 
   // Node data and constrained nodes: GridNodes.
 
- private:
+ protected:
   Lattice lattice_;
+  int ghost_ = 0;
   IVec<D> lo_, hi_;  ///< window cells (inclusive)
   IVec<D> nodes_;    ///< window nodes per axis
   std::array<std::int64_t, D> stride_{};

@@ -15,6 +15,7 @@
 #include "mpm/core/error.hpp"
 #include "mpm/core/units.hpp"
 #include "mpm/core/version.hpp"
+#include "mpm/grid/bspline_grid.hpp"
 #include "mpm/grid/lattice.hpp"
 #include "mpm/run/extremes.hpp"
 #include "mpm/run/history.hpp"
@@ -534,6 +535,16 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
                        "array-expansion");
     ExplicitSolver<SparseGrid<D>> solver(scene, SparseGrid<D>(lattice, scene.boundary),
                                          model.columns, strategy);
+    return run_solver(opt, scene, lattice, solver, restart, rebar);
+  }
+  if (scene.grid.shape == GridShape::Bspline) {
+    if (strategy == ScatterStrategy::Patch)
+      throw InputError("--strategy",
+                       "the patch strategy's slabs hold one layer of nodes past their cells; "
+                       "grid.shape = \"bspline\" reaches two: use colored, lr-slabs or "
+                       "array-expansion");
+    ExplicitSolver<BsplineGrid<D>> solver(scene, BsplineGrid<D>(lattice, scene.boundary),
+                                          model.columns, strategy);
     return run_solver(opt, scene, lattice, solver, restart, rebar);
   }
   UniformSolver<D> solver(scene, UniformGrid<D>(lattice, scene.boundary), model.columns, strategy);

@@ -89,6 +89,22 @@ void prepare_columns(ColumnStore& cols, const Scene& scene) {
     ensure(cols, {col::strain, ScalarType::F64, d, "-"});
     ensure(cols, {col::level, ScalarType::U8, 1, "-"});
   }
+  if (scene.solver.scheme == Scheme::APIC && !cols.has(col::C)) {
+    // APIC's affine velocity: a body spinning at w starts with C = W, the skew tensor of w
+    // (the exact gradient of its rigid rotation); otherwise 0 (velocity_field: first step).
+    cols.add({col::C, ScalarType::F64, d * d, "1/s"});
+    auto* C = reinterpret_cast<double*>(cols.at(col::C).data());
+    for (std::size_t i = 0; i < cols.size(); ++i) {
+      if (mat[i] == kRigidMaterial) continue;
+      const Vec3& w = scene.bodies[body[i]].angular_velocity;
+      double* c = C + i * d * d;  // column-major: c[a + d b] = dv_a / dx_b
+      if (d == 2) {
+        c[1] = w.z(), c[2] = -w.z();
+      } else {
+        c[1] = w.z(), c[2] = -w.y(), c[3] = -w.z(), c[5] = w.x(), c[6] = w.y(), c[7] = -w.x();
+      }
+    }
+  }
   if (d == 2 && scene.plane_stress && !cols.has(col::thickness)) {
     cols.add({col::thickness, ScalarType::F64, 1, "-"});
     double* h = cols.get<double>(col::thickness);
@@ -149,6 +165,7 @@ ParticleView<D> view(ColumnStore& cols) {
   p.f_rebar = cols.get<Vec<D>>(col::f_rebar);
   p.strain = cols.get<Vec<D>>(col::strain);
   p.thickness = cols.get<double>(col::thickness);
+  p.C = cols.get<Mat<D>>(col::C);
   p.id = cols.get<std::uint32_t>(col::id);
   p.material = cols.get<std::uint8_t>(col::material);
   p.body = BodyIds(cols.find(col::body));
@@ -163,7 +180,8 @@ double run_particle_bytes(const Scene& scene) {
   // x and v, m, rho and e, sigma, id, material and body, then the optional columns.
   return 2 * d * 8 + 3 * 8 + 48 + 4 + 1 + 1 + (need.eps_p ? 8 : 0) + (need.T ? 8 : 0) +
          (need.failed ? 1 : 0) + (need.damage ? 8 : 0) + (need.mu_max ? 8 : 0) +
-         (d == 2 && scene.plane_stress ? 8 : 0) + (scene.rebars.empty() ? 0 : d * 8);
+         (d == 2 && scene.plane_stress ? 8 : 0) + (scene.rebars.empty() ? 0 : d * 8) +
+         (scene.solver.scheme == Scheme::APIC ? d * d * 8 : 0);
 }
 
 }  // namespace mpm

@@ -32,7 +32,8 @@ inline const std::string f_ext = "f_ext";        ///< D x f64, applied force (lo
 inline const std::string f_rebar = "f_rebar";    ///< D x f64, rebar elements' force on a node, N
 inline const std::string strain = "strain";  ///< D x f64, accumulated normal strains (graded grids)
 inline const std::string level =
-    "level";  ///< u8, grid level of the particle's spacing (graded grids)
+    "level";                       ///< u8, grid level of the particle's spacing (graded grids)
+inline const std::string C = "C";  ///< D x D f64, APIC's affine velocity (column-major), 1/s
 inline const std::string thickness =
     "thickness";  ///< f64, thickness / initial thickness (plane stress)
 }  // namespace col
@@ -83,6 +84,7 @@ struct ParticleView {
   Vec<D>* f_rebar = nullptr;    ///< the rebar elements' force on their nodes (scenes with rebar)
   Vec<D>* strain = nullptr;     ///< integral of the rate of deformation's diagonal (graded grids)
   double* thickness = nullptr;  ///< thickness / initial thickness (plane stress)
+  Mat<D>* C = nullptr;          ///< APIC's affine velocity (solver.scheme = "APIC")
   std::uint32_t* id = nullptr;
   std::uint8_t* material = nullptr;
   BodyIds body;

@@ -140,6 +140,23 @@ void read_grid(Reader& r, Scene& s) {
   if (g.sparse && !g.levels.empty())
     r.fail("sparse",
            "a graded grid ([[grid.levels]]) keeps its own node list; use one or the other");
+  g.shape =
+      r.choice<GridShape>("shape", {{"linear", GridShape::Linear}, {"bspline", GridShape::Bspline}})
+          .value_or(GridShape::Linear);
+  if (g.shape == GridShape::Bspline) {
+    // What the quadratic B-spline grid has been built and tested for: a dense uniform grid,
+    // 3D and plane strain or stress, without the kernels that still assume a cell's corners.
+    const char* why = !g.levels.empty()     ? "a graded grid ([[grid.levels]])"
+                      : g.sparse            ? "grid.sparse"
+                      : s.axisymmetric      ? "axisymmetric scenes (the axis needs its own kernels)"
+                      : !s.contacts.empty() ? "[[contact]] (the bodies' fields)"
+                      : !s.rebars.empty()   ? "[[rebar]]"
+                                            : nullptr;
+    if (why)
+      r.fail("shape", std::string("\"bspline\" runs on a dense uniform grid in 3D or plane "
+                                  "strain/stress, not with ") +
+                          why + "; use shape = \"linear\"");
+  }
   r.finish();
 }
 

@@ -77,10 +77,25 @@ void read_solver(Reader& r, Scene& s) {
     r.fail("scheme",
            "is for the explicit solver; the implicit one takes solver.implicit.formulation "
            "(\"velocity\" or \"momentum\")");
-  v.scheme =
-      r.choice<Scheme>("scheme",
-                       {{"USF", Scheme::USF}, {"USL", Scheme::USL}, {"MUSL", Scheme::MUSL}}, true)
-          .value_or(Scheme::MUSL);
+  v.scheme = r.choice<Scheme>("scheme",
+                              {{"USF", Scheme::USF},
+                               {"USL", Scheme::USL},
+                               {"MUSL", Scheme::MUSL},
+                               {"APIC", Scheme::APIC}},
+                              true)
+                 .value_or(Scheme::MUSL);
+  if (v.scheme == Scheme::APIC && !s.grid.levels.empty())
+    r.fail("scheme",
+           "\"APIC\" runs on uniform and sparse grids; a graded grid (grid.levels) takes "
+           "\"USF\", \"USL\" or \"MUSL\"");
+  if (v.scheme == Scheme::APIC && !s.contacts.empty())
+    r.fail("scheme",
+           "\"APIC\" does not yet carry the affine momentum into the bodies' own fields of "
+           "[[contact]]; use \"MUSL\" (or drop the [[contact]] entries)");
+  if (v.type == SolverType::Implicit && s.grid.shape == GridShape::Bspline)
+    r.fail("type",
+           "the implicit solver runs on linear shape functions; remove grid.shape = "
+           "\"bspline\" or use solver.type = \"explicit\"");
   v.cfl = r.number("cfl", Bound::Positive).value_or(0.5);
   v.end_time = r.required("end_time", dim::time, Bound::Positive, "80 us");
   if (auto t = r.quantity("dt_max", dim::time, Bound::Positive)) v.dt_max = *t;

@@ -74,8 +74,9 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
   read_rebars(top, s);
 
   {
-    Reader g = top.required_table("grid", {"cell_size", "domain", "padding", "sparse", "levels"},
-                                  "cell_size is required");
+    Reader g =
+        top.required_table("grid", {"cell_size", "domain", "padding", "sparse", "levels", "shape"},
+                           "cell_size is required");
     read_grid(g, s);
   }
   check_particle_spacing(s);

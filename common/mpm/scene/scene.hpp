@@ -201,8 +201,14 @@ struct LevelSpec {
   SourceLoc loc;    ///< key "grid.levels.<index>"
 };
 
+/// The grid's shape functions: multilinear on a cell's corners (the seeds'), or quadratic
+/// B-splines on the 3 x 3 (x 3) nodes around a particle's nearest node (smooth gradients: no
+/// cell-crossing noise, and a node's share of force stays in proportion to its share of mass).
+enum class GridShape { Linear, Bspline };
+
 struct GridSpec {
-  double cell_size = 0;       ///< h, m
+  double cell_size = 0;  ///< h, m
+  GridShape shape = GridShape::Linear;
   bool domain_given = false;  ///< else fitted to the bodies with padding
   Vec3 domain_min = Vec3::Zero();
   Vec3 domain_max = Vec3::Zero();
@@ -263,7 +269,9 @@ struct BoundarySpec {
                                    BoundaryType::Free, BoundaryType::Free, BoundaryType::Free};
 };
 
-enum class Scheme { USF, USL, MUSL };
+/// Explicit update schemes. APIC: the affine particle-in-cell transfer (Jiang et al. 2015),
+/// which keeps angular momentum; each particle carries its velocity gradient C.
+enum class Scheme { USF, USL, MUSL, APIC };
 /// What happens to a particle that leaves the domain.
 enum class OnExit { Stop, Remove };
 

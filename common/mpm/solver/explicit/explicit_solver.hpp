@@ -63,12 +63,18 @@ class ExplicitSolver : public SolverCore<GridT> {
 
  private:
   static constexpr int NMAX = GridT::kMaxNodes;
+  /// The grid gives APIC's node offsets and affine weights (uniform, sparse, B-spline).
+  static constexpr bool kAffine = requires(const GridT& g, std::int64_t k, const Vec<D>& xi,
+                                           const double* N, const Vec<D>* G, Vec<D>* W) {
+    g.offsets(k, xi, W);
+    g.affine_weights(k, xi, N, G, W);
+  };
   using Target = ScatterTarget<D>;
   /// What grid_.v holds when grid_update runs: velocities (grid_velocity ran) or momenta.
   enum class NodeV { Velocity, Momentum };
   /// What g2p updates: the particle velocities; also the positions; or also the remapped
   /// momentum m_p v_p, scattered to the grid (MUSL).
-  enum class G2pMode { Velocity, Move, Remap };
+  enum class G2pMode { Velocity, Move, Remap, Pic };
   /// Whether the stress update also advances the positions.
   enum class Positions { Stay, Move };
   /// Which nodal velocities a contact exchange corrects: grid velocities (USF, before the

@@ -50,6 +50,12 @@ void ExplicitSolver<GridT>::step(double dt, double dt_pace) {
       grid_remap();                                   // v_i = remapped p_i / m_i
       update_stress(grid_.v_remap, Positions::Move);  // x_p (eqs. 7, 9); stress (eqs. 12-15)
       break;
+    case Scheme::APIC:  // affine particle-in-cell (Jiang et al. 2015), stress last as USL
+      p2g<kMass | kMomentum | kForce>();        // p_i = sum N m_p (v_p + C_p (x_i - x_p))
+      grid_update(NodeV::Momentum);             // v_i = (p_i + f_i dt) / m_i
+      g2p<G2pMode::Pic>();                      // v_p = sum N v_i
+      update_stress(grid_.v, Positions::Move);  // C_p = B_p D_p^-1; stress; x_p
+      break;
   }
   if constexpr (GridT::kGraded) split_particles();  // coarse particles in finer cells (004, 3.3)
   leapfrog_balance(dt, dt_pace, internal_start, kinetic_start);

@@ -14,7 +14,10 @@ template <Grid GridT>
 template <typename ExplicitSolver<GridT>::G2pMode M>
 void ExplicitSolver<GridT>::g2p() {
   constexpr bool kRemapped = M == G2pMode::Remap, kMove = M == G2pMode::Move;
-  ScopedTimer timer(timers_, timers_.id(kRemapped ? "g2p_remap" : kMove ? "g2p_move" : "g2p"));
+  ScopedTimer timer(timers_, timers_.id(kRemapped                ? "g2p_remap"
+                                        : kMove                  ? "g2p_move"
+                                        : M == G2pMode::Velocity ? "g2p"
+                                                                 : "g2p_pic"));
   if (contact_.active())
     gather_from_grid<M, true>();
   else
@@ -27,6 +30,7 @@ template <Grid GridT>
 template <typename ExplicitSolver<GridT>::G2pMode M, bool C>
 void ExplicitSolver<GridT>::gather_from_grid() {
   constexpr bool kRemapped = M == G2pMode::Remap, kMove = M == G2pMode::Move;
+  constexpr bool kPic = M == G2pMode::Pic;
   const ParticleView<D> p = view<D>(particles_);
   material_ = p.material;
   const Vec<D>* a_i = grid_.a.data();
@@ -80,7 +84,7 @@ void ExplicitSolver<GridT>::gather_from_grid() {
     Vec<D> a_c[NMAX], v_c[NMAX], q_c[NMAX];
     for (int c = 0; c < nn; ++c) {
       a_c[c] = a_i[nodes[c]];
-      if constexpr (kMove) v_c[c] = v_i[nodes[c]];
+      if constexpr (kMove || kPic) v_c[c] = v_i[nodes[c]];
       q_c[c].setZero();
     }
     for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
@@ -137,16 +141,19 @@ void ExplicitSolver<GridT>::advance_particle(const ParticleView<D>& p, std::uint
                                              const std::int64_t* nd, int nk, const Vec<D>* a_c,
                                              const Vec<D>* v_c, double* N, ChunkSums& s,
                                              std::int64_t bin_key) const {
-  constexpr bool kMove = M == G2pMode::Move;
+  constexpr bool kMove = M == G2pMode::Move, kPic = M == G2pMode::Pic;
   const double dt = dt_;
   grid_.values(key, xi, N);
   Vec<D> a_p = Vec<D>::Zero(), vbar = Vec<D>::Zero();
   for (int c = 0; c < nk; ++c) {
-    a_p += N[c] * (a_c ? a_c[c] : grid_.a[nd[c]]);
-    if constexpr (kMove) vbar += N[c] * (v_c ? v_c[c] : grid_.v[nd[c]]);
+    if constexpr (!kPic) a_p += N[c] * (a_c ? a_c[c] : grid_.a[nd[c]]);
+    if constexpr (kMove || kPic) vbar += N[c] * (v_c ? v_c[c] : grid_.v[nd[c]]);
   }
   const Vec<D> v_old = p.v[i];
-  p.v[i] += dt * a_p;  // (000, eq. 8)
+  if constexpr (kPic)
+    p.v[i] = vbar;  // APIC: the grid's velocity; its affine part C_p in update_stress
+  else
+    p.v[i] += dt * a_p;  // (000, eq. 8)
   s.leapfrog_kinetic += 0.5 * p.m[i] * v_old.dot(p.v[i]);
   if (loads_) s.add_load_work(p, i, dt, gravity_, v_old);
   if constexpr (kMove) {

@@ -54,13 +54,22 @@ void ExplicitSolver<GridT>::scatter_to_grid() {
       if (p.f_ext) fb += p.f_ext[i];
       if (p.f_rebar) fb += p.f_rebar[i];  // the rebar elements' force on a node (004, eq. 13)
     }
+    // APIC: the momentum of the particle's affine field, m_p C_p (x_i - x_p), x_i - x_p = h d_i.
+    Vec<D> d[NMAX];
+    Mat<D> mhC;
+    const bool affine = kAffine && kP && p.C;
+    if constexpr (kAffine)
+      if (affine) grid_.offsets(key, xi, d), mhC = (m_p * grid_.cell_size(key)) * p.C[i];
     for (int c = 0; c < nn; ++c) {
       Vec<D> df = Vec<D>::Zero();
       if constexpr (kF) {
         df = N[c] * fb - Vsigma * G[c];      // (000, eqs. 4-5)
         if (axi) df[0] -= Vs_hoop_r * N[c];  // hoop stress (Sulsky & Schreyer 1996)
       }
-      add(c, m_p * N[c], N[c] * mv_p, df);
+      if (affine)
+        add(c, m_p * N[c], N[c] * (mv_p + mhC * d[c]), df);
+      else
+        add(c, m_p * N[c], N[c] * mv_p, df);
     }
   };
   // Writes into a target at the nodes of a cell.

@@ -88,6 +88,15 @@ template <bool C>
         if (move) vbar += N[c] * (cached ? v_h[c] : v_i[nd[c]]);
       }
       if (p.strain) p.strain[i] += dt * L.diagonal();  // for splitting (004, eq. 23)
+      if constexpr (kAffine)
+        if (p.C) {  // APIC: C_p = B_p D_p^-1 from the velocities v_p came from (Jiang 2015)
+          Vec<D> W[NMAX];
+          grid_.affine_weights(key, xi, N, G, W);
+          Mat<D> Cp = Mat<D>::Zero();
+          for (int c = 0; c < nk; ++c)
+            Cp.noalias() += (cached ? vg_h[c] : vg_i[nd[c]]) * W[c].transpose();
+          p.C[i] = Cp;
+        }
       if (pb.ends_before(i, p.material[i], h_cell)) {
         stress_block(p, pb, scr, s);
         pb.restart(i, p.material[i], h_cell);
