@@ -72,9 +72,10 @@ TEST(Bspline, WeightsAndGradientsAreContinuousAcrossStencils) {
 }
 
 // A particle within half a cell of the domain's edge reaches the ghost node outside; a
-// constrained face holds its own node plane and the ghost plane beyond it; a point outside
-// the domain is reported so even though the widened lattice would hold it.
-TEST(Bspline, GhostNodesBeyondTheFacesAreHeldWithThem) {
+// constrained face holds its own node plane, and the ghost plane beyond it mirrors the plane as
+// far inside; a point outside the domain is reported so even though the widened lattice would
+// hold it.
+TEST(Bspline, GhostNodesBeyondTheFacesMirrorTheNodesInside) {
   BoundarySpec b;
   b.face[0] = BoundaryType::Fixed;  // x_min
   b.face[3] = BoundaryType::Slip;   // y_max
@@ -90,16 +91,29 @@ TEST(Bspline, GhostNodesBeyondTheFacesAreHeldWithThem) {
   // Its stencil starts at the ghost node (-1, -1): global node 0 of the widened lattice.
   EXPECT_EQ(grid.global_node(nodes[0]), IVec<2>(0, 0));
   EXPECT_EQ(grid.global_node(nodes[8]), IVec<2>(2, 2));
-  // Fixed x_min: the ghost plane (widened node 0) and the face (1); slip y_max: 5 and 6.
-  std::vector<int> fixed_x, slip_y;
-  for (const auto& f : grid.fixed_nodes()) fixed_x.push_back(grid.global_node(f.node)[0]);
-  for (const auto& f : grid.slip_nodes()) slip_y.push_back(grid.global_node(f.node)[1]);
-  std::sort(fixed_x.begin(), fixed_x.end());
-  std::sort(slip_y.begin(), slip_y.end());
-  EXPECT_EQ(fixed_x.front(), 0);
-  EXPECT_EQ(fixed_x.back(), 1);
-  EXPECT_EQ(slip_y.front(), 5);
-  EXPECT_EQ(slip_y.back(), 6);
+  // Held: fixed x_min is the widened lattice's node plane 1, slip y_max its plane 5.
+  for (const auto& f : grid.fixed_nodes()) EXPECT_EQ(grid.global_node(f.node)[0], 1);
+  for (const auto& f : grid.slip_nodes()) EXPECT_EQ(grid.global_node(f.node)[1], 5);
+  EXPECT_EQ(grid.fixed_nodes().size(), 7u);
+  EXPECT_EQ(grid.slip_nodes().size(), 7u);
+  // Ghosts: x plane 0 mirrors plane 2 (every component), y plane 6 mirrors plane 4 (y only).
+  int xs = 0, ys = 0;
+  for (const auto& g : grid.ghost_nodes()) {
+    const IVec<2> n = grid.global_node(g.node), m = grid.global_node(g.mirror);
+    if (g.face == 0) {
+      ++xs;
+      EXPECT_EQ(n[0], 0);
+      EXPECT_EQ(m, IVec<2>(2, n[1]));
+      EXPECT_EQ(grid.reflect(g, Vec<2>(1, 2)), Vec<2>(-1, -2));
+    } else {
+      ++ys;
+      EXPECT_EQ(n[1], 6);
+      EXPECT_EQ(m, IVec<2>(n[0], 4));
+      EXPECT_EQ(grid.reflect(g, Vec<2>(1, 2)), Vec<2>(1, -2));
+    }
+  }
+  EXPECT_EQ(xs, 7);
+  EXPECT_EQ(ys, 7);
   EXPECT_EQ(grid.where(Vec<2>(-0.1e-3, 1e-3), key, xi), Where::OutsideDomain);
   EXPECT_EQ(grid.where(Vec<2>(1e-3, 4.1e-3), key, xi), Where::OutsideDomain);
 }

@@ -3,8 +3,8 @@
 /// particle reaches the 3^D nodes around its nearest node, so the grid's "cells" here are the
 /// dual cells between node midpoints: a particle's key is the window index of its stencil's
 /// first node. The lattice is the domain's widened by one cell on every side, whose nodes are
-/// the ghost nodes that particles within half a cell of a face reach; a constrained face holds
-/// its ghost plane too (grid.hpp, collect_face_nodes).
+/// the ghost nodes that particles within half a cell of a face reach; beyond a constrained face
+/// they mirror the nodes inside (grid.hpp, GridNodes::GhostNode).
 ///
 /// Why: a linear node at a cell's far corner gets a sliver of a particle's mass but the full
 /// gradient of its force, so its velocity is noise that USL-type updates feed back (MUSL's

@@ -101,6 +101,24 @@ class GridNodes {
   const BoundarySpec& boundary() const {
     return boundary_;
   }
+  /// A ghost node (outside the domain, beyond a constrained face: B-spline grids) and its
+  /// mirror image in the face's node plane. The face is a plane of symmetry, as if the body's
+  /// mirror image lay beyond it: the ghost's mass, momentum and force fold into the mirror node,
+  /// reflected, and after the update the ghost takes the mirror's velocity, reflected. A slip
+  /// face reflects the normal component, a fixed face every component.
+  struct GhostNode {
+    std::int64_t node, mirror;  ///< mirror: -1 when outside the node arrays
+    int face;
+    bool fixed;
+  };
+  const std::vector<GhostNode>& ghost_nodes() const {
+    return ghosts_;
+  }
+  static Vec<D> reflect(const GhostNode& g, Vec<D> v) {
+    if (g.fixed) return -v;
+    v[g.face / 2] = -v[g.face / 2];
+    return v;
+  }
 
  protected:
   /// Sizes the node arrays to n nodes whose meaning has changed (the next clear is full).
@@ -118,25 +136,35 @@ class GridNodes {
   /// order, then the other axes' nodes with the lower axis fastest.
   /// With `ghost` layers of nodes outside the domain (a lattice widened by that many cells on
   /// every side: the B-spline grid), a face is the node plane `ghost` in from the lattice's
-  /// edge, and the ghost planes beyond it are held with it.
+  /// edge, and the planes beyond it are ghost nodes with their mirrors (GhostNode).
   template <class Index>
   void collect_face_nodes(const IVec<D>& cells, const IVec<D>& lo, const IVec<D>& count,
                           Index&& index, int ghost = 0) {
     fixed_.clear();
     slip_.clear();
+    ghosts_.clear();
     for (int face = 0; face < 2 * D; ++face) {
       const BoundaryType type = boundary_.face[face];
       if (type == BoundaryType::Free) continue;
       const int axis = face / 2;
-      for (int g = 0; g <= ghost; ++g) {
-        const int plane = (face % 2 == 0) ? g : cells[axis] - g;
-        collect_plane(face, axis, plane - lo[axis], count, type, index);
+      const auto plane = [&](int g) { return ((face % 2 == 0) ? g : cells[axis] - g) - lo[axis]; };
+      const bool fixed = type == BoundaryType::Fixed;
+      collect_plane(axis, plane(ghost), count, index, [&](std::int64_t node, const IVec<D>&) {
+        (fixed ? fixed_ : slip_).push_back({node, face});
+      });
+      for (int g = 0; g < ghost; ++g) {
+        const int mirror = plane(2 * ghost - g);
+        collect_plane(axis, plane(g), count, index, [&](std::int64_t node, IVec<D> k) {
+          k[axis] = mirror;
+          const bool inside = mirror >= 0 && mirror < count[axis];
+          ghosts_.push_back({node, inside ? std::int64_t(index(k)) : -1, face, fixed});
+        });
       }
     }
   }
-  template <class Index>
-  void collect_plane(int face, int axis, int local, const IVec<D>& count, BoundaryType type,
-                     Index& index) {
+  /// add(node, k) for the nodes k of the local node plane `local` normal to `axis`.
+  template <class Index, class Add>
+  static void collect_plane(int axis, int local, const IVec<D>& count, Index& index, Add&& add) {
     if (local < 0 || local >= count[axis]) return;
     IVec<D> k = IVec<D>::Zero();
     k[axis] = local;
@@ -148,7 +176,7 @@ class GridNodes {
         k[other0] = i;
         if (other1 >= 0) k[other1] = j;
         const std::int64_t node = index(k);
-        if (node >= 0) (type == BoundaryType::Fixed ? fixed_ : slip_).push_back({node, face});
+        if (node >= 0) add(node, k);
       }
   }
 
@@ -157,6 +185,7 @@ class GridNodes {
 
  private:
   std::vector<FaceNode> fixed_, slip_;
+  std::vector<GhostNode> ghosts_;
 };
 
 /// The lattice geometry the uniform grids share: cubic (square) cells of side h counted from the

@@ -63,6 +63,8 @@ class ExplicitSolver : public SolverCore<GridT> {
 
  private:
   static constexpr int NMAX = GridT::kMaxNodes;
+  /// The grid has ghost nodes beyond the domain's faces (B-spline grids).
+  static constexpr bool kGhosts = requires(const GridT& g) { g.ghost_nodes(); };
   /// The grid gives APIC's node offsets and affine weights (uniform, sparse, B-spline).
   static constexpr bool kAffine = requires(const GridT& g, std::int64_t k, const Vec<D>& xi,
                                            const double* N, const Vec<D>* G, Vec<D>* W) {
@@ -156,6 +158,7 @@ class ExplicitSolver : public SolverCore<GridT> {
     at.nd = at.home ? nodes : other;
     return at;
   }
+  void fold_ghosts(int fields);
   /// v = p / m at the nodes with mass, zero elsewhere, for one field's arrays.
   void momentum_to_velocity(const double* m, Vec<D>* field);
   /// One field's grid update: v_i = (p_i or v_i) + dt f_i / m_i, a_i = f_i / m_i.

@@ -52,6 +52,7 @@ void ExplicitSolver<GridT>::integrate_nodes(const double* m_i, Vec<D>* v, Vec<D>
 template <Grid GridT>
 void ExplicitSolver<GridT>::grid_remap() {
   ScopedTimer timer(timers_, timers_.id("grid_remap"));
+  fold_ghosts(kRemap);
   momentum_to_velocity(grid_.m.data(), grid_.v_remap.data());
   for (int f = 1; f < contact_.field_count(); ++f)
     momentum_to_velocity(contact_.field(f).m.data(), contact_.field(f).q.data());
@@ -114,6 +115,12 @@ void ExplicitSolver<GridT>::hold_nodes(const double* m, Vec<D>* vel, Vec<D>* acc
     vel[f.node][f.face / 2] = 0.0;
     if (acc) acc[f.node][f.face / 2] = 0.0;
   }
+  if constexpr (kGhosts)
+    for (const auto& g : grid_.ghost_nodes()) {  // B-spline grids: the mirror images
+      if (m[g.node] == 0) continue;
+      vel[g.node] = g.mirror < 0 ? Vec<D>::Zero() : grid_.reflect(g, vel[g.mirror]);
+      if (acc) acc[g.node] = g.mirror < 0 ? Vec<D>::Zero() : grid_.reflect(g, acc[g.mirror]);
+    }
   if (!has_rigid_) return;
   // Rigid bodies, serially (a few nodes; the force sums stay in node order).
   const std::int64_t n = std::int64_t(grid_.nodes());

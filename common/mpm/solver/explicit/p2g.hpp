@@ -20,6 +20,21 @@ void ExplicitSolver<GridT>::p2g() {
     scatter_to_grid<F, true>();
   else
     scatter_to_grid<F, false>();
+  fold_ghosts(F);
+}
+
+/// B-spline grids: the ghost nodes' mass, momentum, force or remapped momentum (the `fields`
+/// just scattered) folded into their mirrors, reflected (GridNodes::GhostNode).
+template <Grid GridT>
+void ExplicitSolver<GridT>::fold_ghosts([[maybe_unused]] int fields) {
+  if constexpr (kGhosts)
+    for (const auto& g : grid_.ghost_nodes()) {
+      if (g.mirror < 0 || grid_.m[g.node] == 0) continue;
+      if (fields & kMass) grid_.m[g.mirror] += grid_.m[g.node];
+      if (fields & kMomentum) grid_.v[g.mirror] += grid_.reflect(g, grid_.v[g.node]);
+      if (fields & kForce) grid_.a[g.mirror] += grid_.reflect(g, grid_.a[g.node]);
+      if (fields & kRemap) grid_.v_remap[g.mirror] += grid_.reflect(g, grid_.v_remap[g.node]);
+    }
 }
 
 /// The scatter of p2g; with contact (C), the particles of the bodies in contact add into
