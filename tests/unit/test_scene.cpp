@@ -631,7 +631,7 @@ TEST(SceneErrors, InlineCases) {
       {"bad boundary type", end, end + "\n[boundary]\nx_min = \"sticky\"", "sticky",
        "boundary.x_min: expected one of \"free\", \"slip\", \"fixed\", got 'sticky'"},
       {"bad scheme", end, end + "\nscheme = \"FLIP\"", "FLIP",
-       "solver.scheme: expected one of \"USF\", \"USL\", \"MUSL\", got 'FLIP'"},
+       "solver.scheme: expected one of \"USF\", \"USL\", \"MUSL\", \"APIC\", got 'FLIP'"},
       {"negative end time", end, "end_time = \"-1 us\"", "end_time",
        "solver.end_time: must be > 0, got '-1 us'"},
       {"zero dt_max", end, end + "\ndt_max = 0", "dt_max", "solver.dt_max: must be > 0, got 0"},
