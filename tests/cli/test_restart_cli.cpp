@@ -120,6 +120,42 @@ TEST(Restart, StreamCutAnywhereContinuesBitwise) {
   EXPECT_NE(r.err.find("no intact checkpoint"), std::string::npos) << r.err;
 }
 
+// A graded grid whose level-2 box follows a disk across the domain (the window and the box
+// move, particles split as the box reaches them): cut at every record boundary after the first
+// checkpoint and at random bytes, the run continues into the uninterrupted run's file, byte
+// for byte, GRID records included.
+TEST(Restart, GradedGridsContinueBitwise) {
+  const fs::path dir = temp_dir("restart_graded");
+  const fs::path scene = fs::path(MPM_TEST_DATA) / "cli" / "graded_restart.toml";
+  const fs::path model = dir / "model.mpm", full = dir / "full.mpm";
+  ASSERT_EQ(run(prep + " " + scene.string() + " -o " + model.string(), dir).status, 0);
+  const Result r0 =
+      run(runner + " " + model.string() + " --threads 1 --progress none -o " + full.string(), dir);
+  ASSERT_EQ(r0.status, 0) << r0.err;
+  const std::string bytes = slurp(full);
+  std::uint64_t first = 0;
+  int grids = 0, checkpoints = 0;
+  std::vector<std::uint64_t> cuts;
+  for (const RecordSpan& s : records_of(full)) {
+    grids += s.type == std::uint32_t(RecordType::Grid);
+    if (s.type == std::uint32_t(RecordType::Checkpoint) && ++checkpoints == 1) first = s.end;
+    if (first && s.end < bytes.size()) cuts.push_back(s.end);
+  }
+  EXPECT_EQ(checkpoints, 3);  // at 2, 4 and 6 us
+  EXPECT_GE(grids, 3) << "the box must move between frames";
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<std::uint64_t> any(first, bytes.size() - 1);
+  for (int k = 0; k < 3; ++k) cuts.push_back(any(rng));
+  for (std::uint64_t n : cuts) {
+    const fs::path cut = dir / "cut.mpm";
+    std::ofstream(cut, std::ios::binary) << bytes.substr(0, n);
+    const Result r =
+        run(runner + " --restart " + cut.string() + " --threads 1 --progress none", dir);
+    ASSERT_EQ(r.status, 0) << "cut at byte " << n << ": " << r.err;
+    EXPECT_TRUE(slurp(cut) == bytes) << "cut at byte " << n;
+  }
+}
+
 // -o writes the continued run to another file and leaves the cut one as it was.
 TEST(Restart, RestartToAnotherFileKeepsTheCutOne) {
   const Bar bar("restart_other");

@@ -497,6 +497,40 @@ void GradedGrid<D>::fit(const Vec<D>* x, std::size_t n, int margin) {
 }
 
 template <int D>
+void GradedGrid<D>::save_state(StateValues& s) const {
+  for (int a = 0; a < D; ++a) {
+    const std::string x(1, "xyz"[a]);
+    s.set("grid_window_lo_" + x, wlo_[a]);
+    s.set("grid_window_n_" + x, wn_[a]);
+    s.set("grid_offset_" + x, offset_[a]);
+    s.set("grid_built_offset_" + x, built_offset_[a]);
+    s.set("grid_centre0_" + x, centre0_[a]);
+  }
+  s.set("grid_have_centre0", have_centre0_ ? 1 : 0);
+  s.set("grid_revision", double(revision_));
+  s.set("grid_builds", double(builds_));
+}
+
+template <int D>
+void GradedGrid<D>::restore_state(const StateValues& s) {
+  IVec<D> offset;
+  for (int a = 0; a < D; ++a) {
+    const std::string x(1, "xyz"[a]);
+    wlo_[a] = int(s.get("grid_window_lo_" + x));
+    wn_[a] = int(s.get("grid_window_n_" + x));
+    offset[a] = int(s.get("grid_offset_" + x));
+    offset_[a] = int(s.get("grid_built_offset_" + x));
+    centre0_[a] = s.get("grid_centre0_" + x);
+  }
+  have_centre0_ = s.get("grid_have_centre0") != 0;
+  if (!build(false))
+    throw InputError("checkpoint", "the graded grid's window it holds does not build");
+  offset_ = offset;  // a move still pending takes effect at the next fit, as it would have
+  revision_ = long(s.get("grid_revision"));
+  builds_ = long(s.get("grid_builds"));
+}
+
+template <int D>
 bool GradedGrid<D>::follow(const Vec<D>& centre) {
   if (follow_body_ < 0) return false;
   if (!have_centre0_) {

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "mpm/core/state_values.hpp"
 #include "mpm/core/types.hpp"
 #include "mpm/grid/grid.hpp"
 #include "mpm/grid/lattice.hpp"
@@ -209,6 +210,14 @@ class GradedGrid {
   Vec<D> domain_max() const { return origin_ + h1_ * cells1_.template cast<double>(); }
   /// Displacement of the boxes from their scene position, m.
   Vec<D> box_offset() const { return h1_ * offset_.template cast<double>(); }
+
+  // Checkpoints ------------------------------------------------------------------------------
+  /// What the grid carries from step to step besides the particles: the window, the boxes'
+  /// offset (built and pending), the followed body's first centre, the revision.
+  void save_state(StateValues& s) const;
+  /// Restores save_state's values and builds the grid they describe, before the first sort, so
+  /// that a continued run sorts and steps as the uninterrupted one.
+  void restore_state(const StateValues& s);
 
   // Node data (structure of arrays), as UniformGrid -----------------------------------------
   std::size_t nodes() const { return m.size(); }

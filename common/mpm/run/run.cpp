@@ -228,14 +228,13 @@ struct Restart {
   Frame rebar;  ///< the rebar's elements at the checkpoint (the REBR record before it)
 };
 
-/// True for a solver whose state a checkpoint holds: the explicit solver on a uniform or
-/// sparse grid (the graded grid's window and the implicit solver's state are not saved yet).
+/// True for a solver whose state a checkpoint holds: the explicit solver (the implicit
+/// solver's state is not saved yet).
 template <class Solver>
 constexpr bool kCheckpoints = requires(const Solver& s, StateValues& v) {
   s.save_state(v);
 }
-&&!HasImplicitWork<Solver> &&
-    !std::remove_cvref_t<decltype(std::declval<Solver&>().grid())>::kGraded;
+&&!HasImplicitWork<Solver>;
 
 /// Steps a stop by SIGINT or SIGTERM waits for the particles' next re-sort, so that the
 /// checkpoint it writes continues the run bitwise (CheckpointClock::kMaxWait for the same).
@@ -266,6 +265,7 @@ class TimeLoop {
       const StateValues& s = restart->checkpoint.state;
       frame_ = int(s.get("frame"));
       next_history_ = s.get("next_history");
+      if constexpr (GridT::kGraded) grid_revision_ = long(s.get("grid_revision_written"));
       checkpoint_.restore(s);
     } else {
       out_ = std::make_unique<StreamWriter>(opt.output,
@@ -341,6 +341,7 @@ class TimeLoop {
       solver_.save_state(s);
       s.set("frame", frame_);
       s.set("next_history", next_history_);
+      if constexpr (GridT::kGraded) s.set("grid_revision_written", double(grid_revision_));
       checkpoint_.save(s);
       if (rebar_) write_rebar(0);  // the elements' state, before the checkpoint it goes with
       write_particles(0, [&](const Frame& f) { out_->write_checkpoint(s, f); });
@@ -488,8 +489,7 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
                      HasImplicitWork<Solver>
                          ? "the implicit solver does not write checkpoints (its state is not "
                            "saved yet); remove output.checkpoint"
-                         : "graded grids do not write checkpoints (the window of their levels is "
-                           "not saved yet); remove output.checkpoint");
+                         : "this solver does not write checkpoints; remove output.checkpoint");
   }
   TimeLoop<Solver> loop(opt, scene, lattice, solver, restart, rebar);
   return loop();
@@ -523,8 +523,9 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
       throw InputError("--strategy",
                        "the patch strategy needs a uniform grid; this scene has "
                        "[[grid.levels]] (use colored, lr-slabs or array-expansion)");
-    ExplicitSolver<GradedGrid<D>> solver(scene, GradedGrid<D>(lattice, scene), model.columns,
-                                         strategy);
+    GradedGrid<D> grid(lattice, scene);
+    if (restart) grid.restore_state(restart->checkpoint.state);  // before the first sort
+    ExplicitSolver<GradedGrid<D>> solver(scene, std::move(grid), model.columns, strategy);
     return run_solver(opt, scene, lattice, solver, restart, rebar);
   }
   if (scene.grid.sparse) {
@@ -563,10 +564,6 @@ int restart_model(const RunOptions& opt) {
   if (scene.solver.type == SolverType::Implicit)
     throw InputError("--restart " + opt.restart,
                      "runs of the implicit solver cannot be continued: its checkpoints are not "
-                     "written yet; run the model again");
-  if (!scene.grid.levels.empty())
-    throw InputError("--restart " + opt.restart,
-                     "runs on graded grids cannot be continued: their checkpoints are not "
                      "written yet; run the model again");
   check_restartable(opt.restart, restart.scan);
   restart.checkpoint = load_checkpoint(opt.restart, restart.scan, &restart.rebar);

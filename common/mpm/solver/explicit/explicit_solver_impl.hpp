@@ -120,6 +120,7 @@ void ExplicitSolver<GridT>::save_state(StateValues& s) const {
   s.set("splits", double(split_count_));
   s.set("split_wait", double(split_wait_));
   if (rebar_.active()) s.set("rebar_energy", rebar_sums_.energy);  // in the balance's internal
+  if constexpr (GridT::kGraded) grid_.save_state(s);  // restored before the solver is built
 }
 
 template <Grid GridT>
