@@ -83,6 +83,14 @@ class ImplicitSolver : public SolverCore<GridT> {
   /// Work totals since the start, and of the last step (retries included).
   const ImplicitWork& work() const { return work_; }
   const ImplicitWork& last_work() const { return last_work_; }
+  /// Checkpoints. settle(): the particles sorted, and the warm start and the reused tangent
+  /// factor dropped, so that the step after a checkpoint starts cold both in the run that wrote
+  /// it and in a run continued from it (which never had them): the two stay bitwise equal.
+  void settle();
+  /// The state a checkpoint holds besides the columns (SolverCore's, the step control, the
+  /// work totals); restore_state() takes it back on a solver built from the saved columns.
+  void save_state(StateValues& s) const;
+  void restore_state(const StateValues& s);
   /// ||F||_2 of the dimensionless residual at each Newton iterate of the last attempt.
   const std::vector<double>& last_residuals() const { return last_residuals_; }
 
