@@ -481,6 +481,13 @@ void TimeLoop<Solver>::report(double loop_wall) const {
   if (opt_.stats) print_stats(solver_, omp_get_max_threads(), loop_wall);
 }
 
+/// --strategy patch works on the dense window of linear weights only; `why` says why not here.
+void refuse_patch(ScatterStrategy strategy, const std::string& why) {
+  if (strategy == ScatterStrategy::Patch)
+    throw InputError("--strategy",
+                     "the patch strategy " + why + " (use colored, lr-slabs or array-expansion)");
+}
+
 template <class Solver>
 int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Solver& solver,
                const Restart* restart, ColumnStore* rebar = nullptr) {
@@ -520,31 +527,22 @@ int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame
                      "(it is the default); drop --strategy " +
                          opt.strategy);
   if (graded) {
-    if (strategy == ScatterStrategy::Patch)
-      throw InputError("--strategy",
-                       "the patch strategy needs a uniform grid; this scene has "
-                       "[[grid.levels]] (use colored, lr-slabs or array-expansion)");
+    refuse_patch(strategy, "needs a uniform grid; this scene has [[grid.levels]]");
     GradedGrid<D> grid(lattice, scene);
     if (restart) grid.restore_state(restart->checkpoint.state);  // before the first sort
     ExplicitSolver<GradedGrid<D>> solver(scene, std::move(grid), model.columns, strategy);
     return run_solver(opt, scene, lattice, solver, restart, rebar);
   }
   if (scene.grid.sparse) {
-    if (strategy == ScatterStrategy::Patch)
-      throw InputError("--strategy",
-                       "the patch strategy cuts the dense window into slabs of "
-                       "nodes; with grid.sparse use colored, lr-slabs or "
-                       "array-expansion");
+    refuse_patch(strategy, "cuts the dense window into slabs of nodes, and grid.sparse has none");
     ExplicitSolver<SparseGrid<D>> solver(scene, SparseGrid<D>(lattice, scene.boundary),
                                          model.columns, strategy);
     return run_solver(opt, scene, lattice, solver, restart, rebar);
   }
   if (scene.grid.shape == GridShape::Bspline) {
-    if (strategy == ScatterStrategy::Patch)
-      throw InputError("--strategy",
-                       "the patch strategy's slabs hold one layer of nodes past their cells; "
-                       "grid.shape = \"bspline\" reaches two: use colored, lr-slabs or "
-                       "array-expansion");
+    refuse_patch(strategy,
+                 "holds one layer of nodes past a slab's cells, and grid.shape = \"bspline\" "
+                 "reaches two");
     ExplicitSolver<BsplineGrid<D>> solver(scene, BsplineGrid<D>(lattice, scene.boundary),
                                           model.columns, strategy);
     return run_solver(opt, scene, lattice, solver, restart, rebar);
