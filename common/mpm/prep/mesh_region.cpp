@@ -14,7 +14,7 @@
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/shape_predicates.h>
-#include <CGAL/Polygon_mesh_processing/triangulate_faces.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/boost/graph/helpers.h>
@@ -51,6 +51,37 @@ using Mesh = CGAL::Surface_mesh<Point>;
 using Primitive = CGAL::AABB_face_graph_triangle_primitive<Mesh>;
 using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
 using Side = CGAL::Side_of_triangle_mesh<Mesh, K, CGAL::Default, Tree>;
+
+/// Faces of more than three vertices (quads from exporters) as triangles, each polygon by
+/// CGAL's hole-filling triangulation of its outline (dynamic programming over its vertices: it
+/// always ends, where triangulate_faces on the halfedge mesh looped on a fuzzed OBJ, see
+/// tests/fuzz/README.md). A polygon it cannot split into n - 2 triangles is refused by number.
+void triangulate_polygons(const std::vector<Point>& points,
+                          std::vector<std::vector<std::size_t>>& polygons, const std::string& at,
+                          const std::string& name) {
+  std::vector<std::vector<std::size_t>> out;
+  out.reserve(polygons.size());
+  for (std::size_t f = 0; f < polygons.size(); ++f) {
+    const auto& poly = polygons[f];
+    if (poly.size() == 3) {
+      out.push_back(poly);
+      continue;
+    }
+    std::vector<Point> outline;
+    for (std::size_t i : poly) outline.push_back(points[i]);
+    std::vector<CGAL::Triple<int, int, int>> tris;
+    PMP::triangulate_hole_polyline(outline, std::back_inserter(tris));
+    if (tris.size() != poly.size() - 2)
+      throw InputError(at, "mesh " + name + ": face " + std::to_string(f + 1) + " (" +
+                               std::to_string(poly.size()) +
+                               " vertices) cannot be split into triangles; split it in the "
+                               "file or export triangles");
+    for (const auto& t : tris)
+      out.push_back(
+          {poly[std::size_t(t.first)], poly[std::size_t(t.second)], poly[std::size_t(t.third)]});
+  }
+  polygons.swap(out);
+}
 
 /// Vertices this close (a fraction of the mesh's bounding-box diagonal, in each coordinate) are
 /// one vertex: exporters and unit conversions leave shared vertices a hair apart (an STL with
@@ -162,14 +193,13 @@ Mesh read_placed_mesh(const BodySpec& body, const Scene& scene) {
     PMP::repair_polygon_soup(points, polygons);
     if (polygons.empty())
       throw InputError(at, "mesh " + name + " is empty: it has no (non-degenerate) faces");
+    triangulate_polygons(points, polygons, at, name);
     PMP::orient_polygon_soup(points, polygons);
     if (!PMP::is_polygon_soup_a_polygon_mesh(polygons))
       throw InputError(at, "mesh " + name +
                                " is not a manifold surface (an edge is shared by more than two "
                                "faces); repair it or use a primitive");
     PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
-    if (!CGAL::is_triangle_mesh(mesh) && !PMP::triangulate_faces(mesh))
-      throw InputError(at, "mesh " + name + " has faces that cannot be triangulated");
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
