@@ -153,15 +153,6 @@ TEST(CliSanity, ImplausibleMaterialQuantitiesWarnWithTheUnit) {
   }
 }
 
-}  // namespace
-}  // namespace mpm
-
-namespace mpm {
-namespace {
-
-using namespace mpm::testing;
-namespace fs = std::filesystem;
-
 // A model that cannot fit is refused before anything is allocated, with the estimate: the
 // Taylor bar at 1 nm cells (about 9e21 particles) within a second, exit status 2, the memory
 // named; --max-memory lowers the limit for mpm-prep and mpm-run alike.
@@ -218,15 +209,6 @@ TEST(CliSanity, MeshInMillimetresWithoutDomainWarnsAndIsRefused) {
              "no domain");
 }
 
-}  // namespace
-}  // namespace mpm
-
-namespace mpm {
-namespace {
-
-using namespace mpm::testing;
-namespace fs = std::filesystem;
-
 // A model given to mpm-post's measures, or a result given to mpm-run: each says what the file
 // is and what to run, exit status 2 (no empty CSV with exit 0, no silent re-run from t = 0).
 TEST(CliSanity, ModelsAndResultsAreNotTakenForEachOther) {
@@ -270,14 +252,6 @@ TEST(CliSanity, AClosedPipeStopsMpmPostWithStatusFour) {
   expect_all(r.err, {"mpm-post: error: cannot write 'stdout'", "Broken pipe"}, "particles");
 }
 
-}  // namespace
-}  // namespace mpm
-
-namespace mpm {
-namespace {
-
-using namespace mpm::testing;
-
 // An unquoted --set value with spaces: the shell splits it, and the message says how to quote.
 TEST(CliSanity, UnquotedSetValueGetsAQuotingHint) {
   const auto dir = temp_dir("sanity_set_quotes");
@@ -290,15 +264,6 @@ TEST(CliSanity, UnquotedSetValueGetsAQuotingHint) {
                tool);
   }
 }
-
-}  // namespace
-}  // namespace mpm
-
-namespace mpm {
-namespace {
-
-using namespace mpm::testing;
-namespace fs = std::filesystem;
 
 // A quarter model (examples/sphere-plate: slip faces x = 0 and y = 0 through the middle of
 // plate and ball) is compared whole in mpm-prep's table: mass x 4 against the whole body's

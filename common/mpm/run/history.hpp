@@ -117,20 +117,13 @@ class History {
   /// Checkpoints: the implicit solver's work totals at the last row (its rows give the work
   /// since the row before).
   void save(StateValues& s) const {
-    if (!implicit_) return;
-    s.set("history_newton", double(last_.newton));
-    s.set("history_krylov", double(last_.krylov));
-    s.set("history_evaluations", double(last_.evaluations));
-    s.set("history_line_search_cuts", double(last_.line_search_cuts));
-    s.set("history_step_cuts", double(last_.step_cuts));
+    if (implicit_)
+      ImplicitWork::each(last_, [&](const std::string& n, long v) { s.set("history_" + n, v); });
   }
   void restore(const StateValues& s) {
-    if (!implicit_) return;
-    last_.newton = long(s.get("history_newton"));
-    last_.krylov = long(s.get("history_krylov"));
-    last_.evaluations = long(s.get("history_evaluations"));
-    last_.line_search_cuts = long(s.get("history_line_search_cuts"));
-    last_.step_cuts = long(s.get("history_step_cuts"));
+    if (implicit_)
+      ImplicitWork::each(last_,
+                         [&](const std::string& n, long& v) { v = long(s.get("history_" + n)); });
   }
   void flush(StreamWriter& w) {
     if (block_.rows() == 0) return;

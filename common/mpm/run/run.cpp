@@ -228,12 +228,6 @@ struct Restart {
   Frame rebar;  ///< the rebar's elements at the checkpoint (the REBR record before it)
 };
 
-/// True for a solver whose state a checkpoint holds (all of them now).
-template <class Solver>
-constexpr bool kCheckpoints = requires(const Solver& s, StateValues& v) {
-  s.save_state(v);
-};
-
 /// Steps a stop by SIGINT or SIGTERM waits for the particles' next re-sort, so that the
 /// checkpoint it writes continues the run bitwise (CheckpointClock::kMaxWait for the same).
 constexpr int kSignalWait = 20;
@@ -331,40 +325,35 @@ class TimeLoop {
   /// A CHKP record: the particles in cell order (settle) with the state the columns do not
   /// hold; the history rows before it are flushed first, so the stream up to it is complete.
   void write_checkpoint() {
-    if constexpr (kCheckpoints<Solver>) {
-      ScopedTimer timer(solver_.timers(), t_output_);
-      solver_.settle();
-      history_.flush(*out_);
-      write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
-      StateValues s;
-      solver_.save_state(s);
-      s.set("frame", frame_);
-      s.set("next_history", next_history_);
-      history_.save(s);
-      if constexpr (GridT::kGraded) s.set("grid_revision_written", double(grid_revision_));
-      checkpoint_.save(s);
-      if (rebar_) write_rebar(0);  // the elements' state, before the checkpoint it goes with
-      write_particles(0, [&](const Frame& f) { out_->write_checkpoint(s, f); });
-      checkpoint_.written();
-    }
+    ScopedTimer timer(solver_.timers(), t_output_);
+    solver_.settle();
+    history_.flush(*out_);
+    write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
+    StateValues s;
+    solver_.save_state(s);
+    s.set("frame", frame_);
+    s.set("next_history", next_history_);
+    history_.save(s);
+    if constexpr (GridT::kGraded) s.set("grid_revision_written", double(grid_revision_));
+    checkpoint_.save(s);
+    if (rebar_) write_rebar(0);  // the elements' state, before the checkpoint it goes with
+    write_particles(0, [&](const Frame& f) { out_->write_checkpoint(s, f); });
+    checkpoint_.written();
   }
-  /// Whether to stop for a signal now: at once without checkpoints; with them once the
-  /// particles are due for a re-sort (at most kSignalWait steps on), after a checkpoint.
+  /// Whether to stop for a signal now: after a checkpoint, which the explicit solver writes
+  /// once the particles are due for a re-sort (at most kSignalWait steps on), the implicit one
+  /// at once (as advance() does).
   bool stop_for_signal() {
     if (!g_signal) return false;
-    constexpr bool checkpoint = kCheckpoints<Solver>;
-    if (checkpoint) {
-      if (!solver_.sort_pending() && ++signal_wait_ <= kSignalWait) return false;
-      write_checkpoint();
-    }
+    if (!kImplicit && !solver_.sort_pending() && ++signal_wait_ <= kSignalWait) return false;
+    write_checkpoint();
     status_ = 128 + g_signal;
     message_ = "interrupted by signal " + std::to_string(int(g_signal)) +
                " at t = " + std::to_string(solver_.time()) + " s; the last frame is the state then";
-    if (checkpoint)
-      message_ += opt_.output == "-"
-                      ? "; the stream holds a checkpoint of it: saved to a file, it continues "
-                        "with mpm-run --restart FILE"
-                      : "; continue with: mpm-run --restart " + opt_.output;
+    message_ += opt_.output == "-"
+                    ? "; the stream holds a checkpoint of it: saved to a file, it continues "
+                      "with mpm-run --restart FILE"
+                    : "; continue with: mpm-run --restart " + opt_.output;
     return true;
   }
   /// One step and what follows it: history rows, frames, checkpoints.
@@ -409,15 +398,13 @@ void TimeLoop<Solver>::advance() {
     emit_frame(frame_ == o_.frames ? std::uint32_t(kFrameFinal) : 0u);
     ++frame_;
   }
-  if constexpr (kCheckpoints<Solver>) {
-    checkpoint_.tick(solver_.time());
-    // The explicit solver waits for its own re-sort (the frames stay bitwise those of a run
-    // without checkpoints); the implicit one's steps are long, and a checkpoint drops its warm
-    // start anyway (ImplicitSolver::settle): it writes at once.
-    if (solver_.time() < end_ * (1 - 1e-12) &&
-        checkpoint_.write_now(kImplicit || solver_.sort_pending()))
-      write_checkpoint();
-  }
+  checkpoint_.tick(solver_.time());
+  // The explicit solver waits for its own re-sort (the frames stay bitwise those of a run
+  // without checkpoints); the implicit one's steps are long, and a checkpoint drops its warm
+  // start anyway (ImplicitSolver::settle): it writes at once.
+  if (solver_.time() < end_ * (1 - 1e-12) &&
+      checkpoint_.write_now(kImplicit || solver_.sort_pending()))
+    write_checkpoint();
 }
 
 template <class Solver>
@@ -493,12 +480,7 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
                const Restart* restart, ColumnStore* rebar = nullptr) {
   if constexpr (requires { solver.attach_rebar(*rebar); })
     if (rebar) solver.attach_rebar(*rebar);
-  if constexpr (kCheckpoints<Solver>) {
-    if (restart) solver.restore_state(restart->checkpoint.state);
-  } else if (scene.output.checkpoint_time > 0 || scene.output.checkpoint_wall > 0) {
-    throw InputError("output.checkpoint",
-                     "this solver does not write checkpoints; remove output.checkpoint");
-  }
+  if (restart) solver.restore_state(restart->checkpoint.state);
   TimeLoop<Solver> loop(opt, scene, lattice, solver, restart, rebar);
   return loop();
 }

@@ -134,20 +134,6 @@ void ImplicitSolver<GridT>::settle() {
   tangent_in_use_ = false;
 }
 
-namespace {
-/// The work counters by name, for checkpoints.
-template <class F>
-void each_count(ImplicitWork& w, const std::string& prefix, F&& f) {
-  f(prefix + "steps", w.steps);
-  f(prefix + "newton", w.newton);
-  f(prefix + "krylov", w.krylov);
-  f(prefix + "evaluations", w.evaluations);
-  f(prefix + "line_search_cuts", w.line_search_cuts);
-  f(prefix + "step_cuts", w.step_cuts);
-  f(prefix + "lagrangian_cuts", w.lagrangian_cuts);
-}
-}  // namespace
-
 template <LatticeGrid GridT>
 void ImplicitSolver<GridT>::save_state(StateValues& s) const {
   Core::save_state(s);
@@ -155,9 +141,9 @@ void ImplicitSolver<GridT>::save_state(StateValues& s) const {
   s.set("implicit_next_dt", next_dt_);
   s.set("implicit_last_dt", last_dt_);
   s.set("implicit_cell_measure", cell_measure_);
-  ImplicitWork w = work_, l = last_work_;
-  each_count(w, "implicit_work_", [&](const std::string& n, long v) { s.set(n, double(v)); });
-  each_count(l, "implicit_last_", [&](const std::string& n, long v) { s.set(n, double(v)); });
+  ImplicitWork::each(work_, [&](const std::string& n, long v) { s.set("implicit_work_" + n, v); });
+  ImplicitWork::each(last_work_,
+                     [&](const std::string& n, long v) { s.set("implicit_last_" + n, v); });
 }
 
 template <LatticeGrid GridT>
@@ -167,9 +153,10 @@ void ImplicitSolver<GridT>::restore_state(const StateValues& s) {
   next_dt_ = s.get("implicit_next_dt");
   last_dt_ = s.get("implicit_last_dt");
   cell_measure_ = s.get("implicit_cell_measure");
-  each_count(work_, "implicit_work_", [&](const std::string& n, long& v) { v = long(s.get(n)); });
-  each_count(last_work_, "implicit_last_",
-             [&](const std::string& n, long& v) { v = long(s.get(n)); });
+  ImplicitWork::each(work_,
+                     [&](const std::string& n, long& v) { v = long(s.get("implicit_work_" + n)); });
+  ImplicitWork::each(last_work_,
+                     [&](const std::string& n, long& v) { v = long(s.get("implicit_last_" + n)); });
 }
 
 template <LatticeGrid GridT>

@@ -37,6 +37,17 @@ struct ImplicitWork {
   long step_cuts = 0;         ///< steps retried with a smaller dt
   long lagrangian_cuts = 0;   ///< of those, retried because the grid would fold
   ImplicitWork& operator+=(const ImplicitWork& o);
+  /// f(name, counter) for every counter of w (const or not): what checkpoints save by name.
+  template <class W, class F>
+  static void each(W& w, F&& f) {
+    f("steps", w.steps);
+    f("newton", w.newton);
+    f("krylov", w.krylov);
+    f("evaluations", w.evaluations);
+    f("line_search_cuts", w.line_search_cuts);
+    f("step_cuts", w.step_cuts);
+    f("lagrangian_cuts", w.lagrangian_cuts);
+  }
 };
 
 /// A grid whose nodes have indices in the lattice of the whole domain (the warm start and
