@@ -4,12 +4,16 @@
 # residual velocity (mpm-post residual), steps, wall time and throughput (mpm-run --stats) of
 # each go to study/table.md (table.py).
 # Usage: ./study.sh BUILD_DIR THREADS "446 575 730" "graded uniform" [END_TIME [DIR]]
+# Grids: graded (scene.toml), graded3 (with a 0.5 mm third level over the path), uniform (1 mm).
 # END_TIME (e.g. 60us) cuts every run short (a cost comparison, not a residual velocity); DIR
 # is the output directory (default study).
 set -euo pipefail
 cd "$(dirname "$0")"
 bin=$1 threads=$2 speeds=$3 grids=$4 end=${5:-} study=${6:-study}
 mkdir -p "$study"
+# graded3's boxes: scene.toml's level 2 and a level 3 inside it.
+level2='{level=2, min="0 -38 -40 mm", max="24 10 14 mm"}'
+level3='{level=3, min="0 -26 -30 mm", max="10 8 4 mm"}'
 # 004 Table 9's end times; the rod flies along (0, -sin 30, -cos 30).
 end_time() {
   if [ -n "$end" ]; then echo "$end"; return; fi
@@ -21,8 +25,12 @@ for v in $speeds; do
     name=${g}_$v
     case $g in
       graded) grid=() ;;
+      # The seed's two levels and a third (0.5 mm) over the path through the plate, 1 mm inside
+      # level 2's box (the nesting rule) and 10 mm across from the symmetry plane: the rod's
+      # 6.45 mm radius and the hole's lip (results.md, "A third level").
+      graded3) grid=(--set "grid.levels=[$level2, $level3]") ;;
       uniform) grid=(--set 'grid.levels=[]' --set grid.cell_size=1mm) ;;
-      *) echo "study.sh: unknown grid '$g' (graded or uniform)" >&2; exit 2 ;;
+      *) echo "study.sh: unknown grid '$g' (graded, graded3 or uniform)" >&2; exit 2 ;;
     esac
     echo "running $name ($(date +%H:%M:%S)) ..." >&2
     "$bin/mpm-prep/mpm-prep" scene.toml "${grid[@]}" --set "bodies.projectile.velocity=$vel" \
@@ -35,10 +43,14 @@ for v in $speeds; do
     rm -f "$study"/$name.model
     "$bin/mpm-post/mpm-post" residual "$study"/$name.mpm --body projectile --target plate --json \
       > "$study"/residual_$name.json 2> "$study"/residual_$name.log || true
-    if [ "$g" = graded ]; then
-      "$bin/mpm-post/mpm-post" render "$study"/$name.mpm -o "$study"/section_$v.png --view symmetry \
+    if [ "$g" != uniform ]; then
+      case $g in
+        graded) picture=section_$v.png cells="2 mm / 1 mm" ;;
+        graded3) picture=section_graded3_$v.png cells="2 mm / 1 mm / 0.5 mm" ;;
+      esac
+      "$bin/mpm-post/mpm-post" render "$study"/$name.mpm -o "$study"/$picture --view symmetry \
         --field eps_p --size 900x700 \
-        --title "V6 at $v m/s, graded 2 mm / 1 mm: section through the path (x = 0)" || true
+        --title "V6 at $v m/s, graded $cells: section through the path (x = 0)" || true
     fi
   done
 done

@@ -2,7 +2,8 @@
 """V6 study table: residual velocity against the experiment and the seed, with the cost.
 
 Reads study/residual_<grid>_<v>.json (mpm-post residual --json) and study/run_<grid>_<v>.log
-(mpm-run --stats) for grid in graded, uniform and writes study/table.md.
+(mpm-run --stats) for grid in graded, graded3, uniform and writes study/table.md (graded3:
+the seed's two levels and a third, 0.5 mm, over the path through the plate).
 The residual velocity is the projectile's speed when its tail has left the plate's rear face
 (as the experiment's flash radiographs see it behind the plate); at the end of the run when
 the tail is not out by then (marked).
@@ -68,20 +69,20 @@ def main():
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for v in (446, 575, 730):
-        cases = {g: read_case(study, g, v) for g in ("graded", "uniform")}
+        cases = {g: read_case(study, g, v) for g in ("graded", "graded3", "uniform")}
         for g, c in cases.items():
             if not c:
                 continue
             ratio = ""
             seed_ratio = ""
-            if g == "graded":
+            if g == "graded":  # the seed's grid against its uniform fine grid (1 mm)
                 u = cases.get("uniform")
                 if u and "wall" in u and "wall" in c:
                     ratio = f"{c['wall'] / u['wall']:.2f}"
                 seed_ratio = f"{SEED_MIN[v][0] / SEED_MIN[v][1]:.2f}"
             vr = c.get("vr")
             err = f"{100 * (vr - EXPERIMENT[v]) / EXPERIMENT[v]:+.1f}%" if vr is not None else "-"
-            seed = SEED_GRADED[v] if g == "graded" else SEED_UNIFORM[v]
+            seed = SEED_UNIFORM[v] if g == "uniform" else SEED_GRADED[v]
             note = "" if c.get("when") == "tail out" else " (end, tail in plate)"
             if c.get("when") != "tail out" and c.get("t_end_us", 1e9) < 150:
                 note = f" (run cut at {c['t_end_us']:.0f} us: cost only)"

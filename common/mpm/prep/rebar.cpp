@@ -242,6 +242,7 @@ ColumnStore discretise_rebar(const Scene& scene, const Lattice& lattice,
   for (std::size_t k = 0; k < nn; ++k) ++report[owner[k]].nodes, report[owner[k]].mass += m[n0 + k];
   ColumnStore el = rebar_element_columns();
   el.resize(rows.bar.size());
+  if (rows.bar.empty()) return el;  // no rebar: empty columns have no storage to copy into
   std::memcpy(el.at(rebar_col::nodes).data(), rows.nodes.data(), rows.nodes.size() * 4);
   std::memcpy(el.at(rebar_col::bar).data(), rows.bar.data(), rows.bar.size() * 4);
   std::memcpy(el.at(rebar_col::material).data(), rows.material.data(), rows.material.size());
