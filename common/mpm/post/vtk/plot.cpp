@@ -101,6 +101,7 @@ void plot_residual_png(const ResidualResult& r, const std::string& path, int wid
   if (r.exit) add_line(chart, exit, 1, black, vtkChart::POINTS, 8.0f);
   chart->GetAxis(vtkAxis::BOTTOM)->SetTitle("time (us)");
   chart->GetAxis(vtkAxis::LEFT)->SetTitle("velocity (m/s)");
+  [[maybe_unused]] const GraphicsStack graphics;
   view->Render();  // initialises the window's OpenGL context before the pixels are read
   write_png(window, path);
 }

@@ -13,9 +13,6 @@
 #include <vtkUnstructuredGrid.h>
 #include <vtkWindowToImageFilter.h>
 #include <vtkXMLUnstructuredGridWriter.h>
-#if defined(__SANITIZE_ADDRESS__)
-#include <sanitizer/lsan_interface.h>
-#endif
 
 #include <cerrno>
 #include <cstdio>
@@ -136,14 +133,7 @@ void write_unstructured(vtkUnstructuredGrid* grid, double time, std::int64_t ste
 
 /// Renders the window once and writes its back buffer as a PNG through a FileTarget.
 void write_png(vtkRenderWindow* window, const std::string& path) {
-#if defined(__SANITIZE_ADDRESS__)
-  // make test-asan: the first render loads Mesa's GL driver, which is unloaded again with the
-  // window and leaves allocations behind that LeakSanitizer can pin on no module (so no
-  // suppression can name them), and VTK's PNG writer leaves libpng's structures behind when it
-  // cannot write. Allocations made here, inside the graphics stack, are not counted as leaks;
-  // the rest of mpm-post and of every test is checked.
-  __lsan::ScopedDisabler graphics_stack;
-#endif
+  [[maybe_unused]] const GraphicsStack graphics;
   // The filter renders the window once (its ShouldRerender) and reads the back buffer.
   vtkNew<vtkWindowToImageFilter> grab;
   grab->SetInput(window);
