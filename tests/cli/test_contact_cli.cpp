@@ -63,6 +63,10 @@ TEST(ContactCli, BadContactInputExitsTwoNamingFileLineAndKey) {
        "[[contact]]\nbodies = [\"block\", \"lid\"]\nnormal = \"plate\"\n",
        "normal",
        {"contact.0.normal", "'block' or 'lid'", "got 'plate'"}},
+      {"gap.toml",
+       "[[contact]]\nbodies = [\"block\", \"lid\"]\ngap = 0\n",
+       "gap",
+       {"contact.0.gap", "> 0"}},
       {"twice.toml",
        "[[contact]]\nbodies = [\"lid\", \"block\"]\n\n[[contact]]\nbodies = [\"block\", "
        "\"lid\"]\nfriction = 0.3\n",
@@ -89,7 +93,8 @@ TEST(ContactCli, BadContactInputExitsTwoNamingFileLineAndKey) {
   // A pair's keys are set by index from the command line (docs/scene.md), and they are
   // checked as in the file.
   EXPECT_EQ(run(prep + " " + good.string() +
-                    " --set contact.0.friction=0.2 --set contact.0.normal=lid -o /dev/null",
+                    " --set contact.0.friction=0.2 --set contact.0.normal=lid"
+                    " --set contact.0.gap=0.8 -o /dev/null",
                 dir)
                 .status,
             0);

@@ -33,8 +33,8 @@
 //   The particles' accelerations are taken against the corrected velocities, so that
 //   impulse reaches them too.
 // The gap check: two fields touch at a node when their centres there, sum_p m_p N_i x_p / m_i,
-// are closer than ContactFields::touch() cells along n; without it bodies a cell apart would
-// already push on each other (Huang et al. 2011).
+// are closer than the pair's `gap` (1.5 of the finest cell by default) along n; without it
+// bodies a cell apart would already push on each other (Huang et al. 2011).
 #include <omp.h>
 
 #include <algorithm>
@@ -67,7 +67,7 @@ void ExplicitSolver<GridT>::exchange_momentum(Exchange on) {
     g_f[f] = fd.g.data();
     x_f[f] = fd.x.data();
   }
-  const double touch = contact_.touch() * grid_.min_cell_size();
+  const double cell = grid_.min_cell_size();
   const bool update = on == Exchange::Update;  // accelerations and forces follow
   // The step's first exchange decides which pairs touch at each node, the second follows.
   const bool decide = on == Exchange::Velocity || (update && scheme_ != Scheme::USF);
@@ -123,7 +123,7 @@ void ExplicitSolver<GridT>::exchange_momentum(Exchange on) {
             } else {
               if (w_n <= 0) continue;  // separating: free
               const Vec<D> gap = x_f[b][i] / mb - x_f[a][i] / ma;
-              if (gap.dot(nrm) > touch) continue;  // apart: free
+              if (gap.dot(nrm) > contact_.touch(a, b) * cell) continue;  // apart: free
               if (decide && s < 64) state |= std::uint64_t(1) << s;
             }
             const Vec<D> J_n = -m_ab * w_n * nrm;

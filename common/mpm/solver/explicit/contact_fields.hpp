@@ -45,12 +45,14 @@ class ContactFields {
         }
     const int F = field_count();
     friction_.assign(std::size_t(F * F), -1.0);
+    gap_.assign(std::size_t(F * F), 0.0);
     pair_.assign(std::size_t(F * F), -1);
     normal_.assign(std::size_t(F * F), kSteeper);
     for (std::size_t k = 0; k < scene.contacts.size(); ++k) {
       const ContactSpec& c = scene.contacts[k];
       const int a = field_of_body_[c.body_a], b = field_of_body_[c.body_b];
       friction_[a * F + b] = friction_[b * F + a] = c.friction;
+      gap_[a * F + b] = gap_[b * F + a] = c.gap;
       using N = ContactSpec::Normal;
       const int own = c.normal == N::BodyA ? a : c.normal == N::BodyB ? b : -1;
       normal_[a * F + b] = normal_[b * F + a] = own >= 0                 ? own
@@ -87,12 +89,10 @@ class ContactFields {
   /// Per node, the pairs of fields in contact after the last grid update (bit s: the s-th
   /// pair of the fields present at the node, in field order); MUSL's remap follows them.
   std::vector<std::uint64_t>& held() { return held_; }
-  /// Gap below which two fields touch at a node, in cells (distance of their centres there):
-  /// for two particles a cell per axis, bodies touching anywhere in a cell put those centres
-  /// 0.70 to 0.98 cells apart (linear shape functions); 1.5 leaves room for deformed
-  /// particles, so that bodies that touch are always in contact, and bodies more than half a
-  /// cell apart are not.
-  static constexpr double touch() { return 1.5; }
+  /// Gap below which fields a and b touch at a node, in cells (distance of their centres
+  /// there; the pair's `gap`): for two particles a cell per axis, bodies touching anywhere in
+  /// a cell put those centres 0.70 to 0.98 cells apart (linear shape functions).
+  double touch(int a, int b) const { return gap_[a * field_count() + b]; }
 
   /// Sizes every field to `nodes` nodes and zeroes mass, momentum, force and mass gradient
   /// (and the remapped momentum when `remap`).
@@ -126,6 +126,7 @@ class ContactFields {
   std::vector<Field> fields_;
   std::vector<std::uint8_t> field_of_body_;
   std::vector<double> friction_;
+  std::vector<double> gap_;
   std::vector<int> normal_;
   std::vector<int> pair_;
   std::vector<double> sign_;
