@@ -148,11 +148,16 @@ void ExplicitSolver<GridT>::stress_block(const ParticleView<D>& p, PendingBlock&
                                          StressScratch& scr, ChunkSums& s) const {
   if (pb.k == 0) return;
   const MaterialBlock blk = update_block(pb, p, scr);
+  // In registers, not through s: the block's internal energy, and its fastest signal
+  // (min_j h / s_j is h / max_j s_j exactly: a division is monotone, one is enough).
+  double internal = 0, fastest = 0;
   for (int j = 0; j < pb.k; ++j) {
     const std::uint32_t i = pb.i0 + j;
-    s.internal += p.m[i] * p.e[i];
-    s.dt_min = std::min(s.dt_min, pb.h / (scr.c[j] + p.v[i].norm()));
+    internal += p.m[i] * p.e[i];
+    fastest = std::max(fastest, scr.c[j] + p.v[i].norm());
   }
+  s.internal += internal;
+  s.dt_min = std::min(s.dt_min, pb.h / fastest);
   if (blk.fault_index >= 0 && s.fault < 0) {
     s.fault = pb.i0 + blk.fault_index;
     s.cause = blk.fault == PointFault::VolumeInverted

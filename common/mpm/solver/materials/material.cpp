@@ -20,7 +20,7 @@ double isentropic_bulk(double K, double B, double p, double rho) {
 /// The signal speed the time step uses: sound speed c widened by the bulk viscosity, as in
 /// hydrocodes: dt <= h / (Q + sqrt(Q^2 + c^2)), Q = C1 c + C0 h |tr D| in compression.
 double widened(double c, double Q) {
-  return Q + std::sqrt(Q * Q + c * c);
+  return Q > 0 ? Q + std::sqrt(Q * Q + c * c) : c;  // sqrt(c^2) is c in binary floating point
 }
 }  // namespace
 
@@ -32,11 +32,13 @@ Material::EnergyStep Material::energy_step(const MaterialBlock& b, const BlockSc
   const double rho = b.rho[i];
   const double dvol = S.dvol[i];
   const double trD = dvol / b.dt;
-  const double c_bulk = std::sqrt(std::max(S.K[i], 0.0) / rho);
   EnergyStep es;
-  // Artificial bulk viscosity in compression, linear + quadratic.
-  es.q =
-      trD < 0 ? rho * b.h * (bulk_quadratic_ * b.h * trD * trD - bulk_linear_ * c_bulk * trD) : 0.0;
+  // Artificial bulk viscosity in compression, linear + quadratic (the bulk sound speed only
+  // there: a square root is the dearest thing in this loop).
+  if (trD < 0) {
+    const double c_bulk = bulk_linear_ > 0 ? std::sqrt(std::max(S.K[i], 0.0) / rho) : 0.0;
+    es.q = rho * b.h * (bulk_quadratic_ * b.h * trD * trD - bulk_linear_ * c_bulk * trD);
+  }
   const double v_old = 1.0 / (rho * (1.0 + dvol));  // rho is already the new density
   es.k = 0.5 * dvol * v_old;
   es.v_mid = v_old * (1.0 + 0.5 * dvol);
@@ -319,29 +321,49 @@ void Material::update_iterating(MaterialBlock& b, PlaneStressIteration& it, cons
 
 void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
   const double dt = b.dt;
-  // Kinematics: strain and spin increments, Jaumann rotation, density (000, eqs. 12-15).
+  // Kinematics: strain and spin increments, Jaumann rotation, density (000, eqs. 12-15),
+  // component by component in Voigt order (xx, yy, zz, yz, xz, xy): the rotation term
+  // dW.sigma - sigma.dW of a symmetric sigma and a skew dW is symmetric, 24 products where the
+  // 3x3 matrix products took 54, and nothing goes through memory but the block's columns.
   for (int i = 0; i < b.n; ++i) {
     const Mat3& L = b.L[i];
-    const Mat3 dE = 0.5 * dt * (L + L.transpose());  // (000, eq. 12)
-    const Mat3 dW = 0.5 * dt * (L - L.transpose());  // (000, eq. 13)
-    const double dvol = dE.trace();
-    if (!(1.0 + dvol > 0.0)) {
+    const double h = 0.5 * dt;
+    const double dxx = dt * L(0, 0), dyy = dt * L(1, 1), dzz = dt * L(2, 2);  // (000, eq. 12)
+    const double dyz = h * (L(1, 2) + L(2, 1)), dxz = h * (L(0, 2) + L(2, 0)),
+                 dxy = h * (L(0, 1) + L(1, 0));
+    const double wxy = h * (L(0, 1) - L(1, 0)), wxz = h * (L(0, 2) - L(2, 0)),
+                 wyz = h * (L(1, 2) - L(2, 1));  // dW above the diagonal (000, eq. 13)
+    const double dvol = dxx + dyy + dzz;
+    const Sym& s0 = b.sigma[i];
+    if (!(1.0 + dvol > 0.0)) [[unlikely]] {
       if (b.fault_index < 0) b.fault_index = i, b.fault = PointFault::VolumeInverted;
       S.dvol[i] = 0;
       S.de[i].setZero();
-      S.s_old[i] = S.s[i] = deviator(b.sigma[i]);
-      S.P_old[i] = -trace(b.sigma[i]) / 3.0;
+      S.s_old[i] = S.s[i] = deviator(s0);
+      S.P_old[i] = -trace(s0) / 3.0;
       continue;
     }
-    Mat3 sig = to_matrix(b.sigma[i]);
-    sig += dW * sig - sig * dW;  // rotation term dr = dw.sigma - sigma.dw (000, eq. 15)
-    const Sym sv = to_voigt(sig);
-    S.P_old[i] = -trace(sv) / 3.0;
-    S.s_old[i] = S.s[i] = deviator(sv);
-    S.de[i] = deviator(to_voigt(dE));
+    const double sxx = s0[0], syy = s0[1], szz = s0[2], syz = s0[3], sxz = s0[4], sxy = s0[5];
+    // sigma + dW.sigma - sigma.dW (000, eq. 15).
+    Sym sv;
+    sv[0] = sxx + 2.0 * (wxy * sxy + wxz * sxz);
+    sv[1] = syy + 2.0 * (wyz * syz - wxy * sxy);
+    sv[2] = szz - 2.0 * (wxz * sxz + wyz * syz);
+    sv[3] = syz + wyz * (szz - syy) - wxy * sxz - wxz * sxy;
+    sv[4] = sxz + wxz * (szz - sxx) + wxy * syz - wyz * sxy;
+    sv[5] = sxy + wxy * (syy - sxx) + wxz * syz + wyz * sxz;
+    const double m = (sv[0] + sv[1] + sv[2]) / 3.0;
+    S.P_old[i] = -m;
+    Sym sd = sv;
+    sd[0] -= m, sd[1] -= m, sd[2] -= m;
+    S.s_old[i] = sd;
+    S.s[i] = sd;
+    const double dm = dvol / 3.0;
+    Sym de;
+    de << dxx - dm, dyy - dm, dzz - dm, dyz, dxz, dxy;
+    S.de[i] = de;
     S.dvol[i] = dvol;
-    const double rho_new = b.rho[i] / (1.0 + dvol);  // (000, eq. 14)
-    b.rho[i] = rho_new;
+    b.rho[i] = b.rho[i] / (1.0 + dvol);  // (000, eq. 14)
   }
 
   // A pressure-dependent strength (HJC) takes the EOS's pressure at the new density and the
@@ -358,53 +380,63 @@ void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
   else
     tangent_at_step_energy(b, S);
 
+  // The energy equation and the new stress, in short passes over the block (a loop whose
+  // body is a few dozen instructions without calls keeps several particles in flight, or is
+  // vectorised; one long body with the failure branch in it ran one particle at a time).
+  const int n = b.n;
+  double* q = S.q;
+  double* k = S.k;
+  double* e_star = S.e_star;
+  double* p = S.p_new;
+  for (int i = 0; i < n; ++i) {
+    const EnergyStep es = energy_step(b, S, i);
+    q[i] = es.q, k[i] = es.k;
+    e_star[i] = es.e_star(b.e[i], S.s_old[i], S.s[i], S.de[i], S.P_old[i]);
+    p[i] = es.pressure(S.A[i], S.B[i], e_star[i]);
+  }
+  // Failure: no deviatoric stress, no tension (000, section 5.3).
   const double eps_f = spec_.failure.plastic_strain;
   const double p_min = spec_.failure.pressure;
   const bool failure = spec_.failure.enabled() && b.failed;
-  for (int i = 0; i < b.n; ++i) {
-    const double rho = b.rho[i];
-    const double trD = S.dvol[i] / dt;
-    const EnergyStep es = energy_step(b, S, i);
-    const double q = es.q, k = es.k;
-    auto pressure = [&](const Sym& s_new, double& e_star) {
-      e_star = es.e_star(b.e[i], S.s_old[i], s_new, S.de[i], S.P_old[i]);
-      return es.pressure(S.A[i], S.B[i], e_star);
-    };
-    double e_star;
-    double p = pressure(S.s[i], e_star);
-    // Failure: no deviatoric stress, no tension (000, section 5.3).
-    if (failure) {
-      const bool now = b.failed[i] || (b.eps_p && b.eps_p[i] >= eps_f) || p <= p_min;
-      if (now) {
-        b.failed[i] = 1;
-        S.s[i].setZero();
-        p = pressure(S.s[i], e_star);
-        if (p < 0) p = 0;
-      }
+  if (failure)
+    for (int i = 0; i < n; ++i) {
+      if (!(b.failed[i] || (b.eps_p && b.eps_p[i] >= eps_f) || p[i] <= p_min)) continue;
+      b.failed[i] = 1;
+      S.s[i].setZero();
+      const EnergyStep es = energy_step(b, S, i);
+      e_star[i] = es.e_star(b.e[i], S.s_old[i], S.s[i], S.de[i], S.P_old[i]);
+      p[i] = std::max(es.pressure(S.A[i], S.B[i], e_star[i]), 0.0);
     }
-    b.e[i] = e_star - (p + q) * k;
+  const double G43 = 4.0 / 3.0 * G_, c2_rest = K0_eos_ / spec_.density;
+  for (int i = 0; i < n; ++i) {
+    const double rho = b.rho[i], P = p[i] + q[i];
+    b.e[i] = e_star[i] - P * k[i];
     Sym sigma = S.s[i];
-    sigma[0] -= p + q;
-    sigma[1] -= p + q;
-    sigma[2] -= p + q;
+    sigma[0] -= P;
+    sigma[1] -= P;
+    sigma[2] -= P;
     b.sigma[i] = sigma;
     // Signal speed for the time step: the isentropic sound speed, widened by the viscosity.
-    const double K_s = isentropic_bulk(S.K[i], S.B[i], p, rho);
+    const double K_s = isentropic_bulk(S.K[i], S.B[i], p[i], rho);
     // A failed particle has no shear stiffness (s = 0), and with its pressure clamped at zero
     // in expansion none at all: it moves ballistically until it is compressed back towards
     // rho0, where waves start at the EOS's bulk speed there. Without this its G / rho and the
     // EOS's floor under K made the expanding debris of V4 (rho ~ rho0 / 300) set the step
     // with 21 km/s where no wave can run.
     const bool failed_now = failure && b.failed[i];
-    double c2 = (K_s + (failed_now ? 0.0 : 4.0 / 3.0 * G_)) / rho;
-    if (failed_now && p <= 0 && q <= 0) c2 = std::min(c2, K0_eos_ / spec_.density);
+    double c2 = (K_s + (failed_now ? 0.0 : G43)) / rho;
+    if (failed_now && p[i] <= 0 && q[i] <= 0) c2 = std::min(c2, c2_rest);
     const double c = std::sqrt(c2);
+    const double trD = S.dvol[i] / dt;
     const double Q = trD < 0 ? bulk_linear_ * c + bulk_quadratic_ * b.h * (-trD) : 0.0;
     b.c[i] = widened(c, Q);
-    if (!std::isfinite(b.e[i]) || !sigma.allFinite() || !std::isfinite(rho)) {
-      if (b.fault_index < 0) b.fault_index = i, b.fault = PointFault::NonFinite;
-    }
   }
+  if (b.fault_index < 0)
+    for (int i = 0; i < n; ++i)
+      if (!std::isfinite(b.e[i]) || !b.sigma[i].allFinite() || !std::isfinite(b.rho[i])) {
+        b.fault_index = i, b.fault = PointFault::NonFinite;
+        break;
+      }
 }
 
 }  // namespace mpm

@@ -99,6 +99,9 @@ struct BlockScratch {
   double dlambda[kBlock];  ///< plastic strain increment of this step
   double yield[kBlock];    ///< flow stress after the step, Pa
   double p[kBlock];        ///< pressure-dependent strength: the EOS's p at the new density, Pa
+  double k[kBlock];        ///< half the change of specific volume over the step, m^3/kg
+  double e_star[kBlock];   ///< energy before the new pressure's work, J/kg
+  double p_new[kBlock];    ///< the new pressure (without viscosity), Pa
 };
 
 /// Equation of state, written as p = A(rho) + B(rho) e with e the specific internal energy,
