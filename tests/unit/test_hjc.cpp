@@ -242,6 +242,33 @@ TEST(Hjc, PlaneStressIterationRestoresTheHistory) {
   EXPECT_GT(sheet.mu_max, 0.001);                                        // and crush
 }
 
+// Concrete fully damaged (D = 1) has no strength at zero pressure or in tension: its deviator
+// is returned to zero whatever the strain, and it regains strength only when compressed back
+// to rho0. The signal speed that sets the time step keeps the shear term at that density:
+// sqrt(K / rho0 + 4G / 3 rho0) in expansion (HJC's p = K mu has rho dp/drho = K rho / rho0), the
+// intact speed, at any density. With 4G / 3 rho, debris of V5 flung off the slab at rho0 / 3000
+// set a step of 22 ns (130 km/s; the run took 6180 steps where 993 do).
+TEST(Hjc, FullyDamagedExpandedConcreteKeepsTheStepOfRho0) {
+  SolverSpec no_viscosity;
+  no_viscosity.bulk_linear = no_viscosity.bulk_quadratic = 0;
+  const MaterialSpec spec = concrete();
+  const Material mat(spec, no_viscosity);
+  const double K = 16e9, G = mat.shear_modulus(), rho0 = spec.density;
+  const double c0 = std::sqrt((K + 4.0 / 3.0 * G) / rho0);
+  Point intact;
+  intact.update(mat, Mat3::Zero(), 1e-9, false);
+  EXPECT_NEAR(intact.c, c0, 1e-12 * c0);
+  const Mat3 expanding = Mat3::Identity() * (1e2 / 3.0);  // tr D = 100 / s
+  for (const double ratio : {0.9, 1e-2, 1.0 / 3000}) {
+    Point d;
+    d.rho = rho0 * ratio;
+    d.D = 1.0;
+    d.update(mat, expanding, 1e-9, false);
+    EXPECT_EQ(d.sigma.norm(), 0.0) << ratio;  // p = K mu < 0 is past the cut-off T (1 - D) = 0
+    EXPECT_NEAR(d.c, c0, 1e-9 * c0) << ratio;
+  }
+}
+
 TEST(Hjc, ColumnsOnlyWhenUsed) {
   Scene s;
   s.materials.push_back(concrete());

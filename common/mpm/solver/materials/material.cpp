@@ -319,12 +319,14 @@ void Material::update_iterating(MaterialBlock& b, PlaneStressIteration& it, cons
   }
 }
 
-void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
+namespace {
+/// Kinematics: strain and spin increments, Jaumann rotation, density (000, eqs. 12-15),
+/// component by component in Voigt order (xx, yy, zz, yz, xz, xy): the rotation term
+/// dW.sigma - sigma.dW of a symmetric sigma and a skew dW is symmetric, 24 products where the
+/// 3x3 matrix products took 54, and nothing goes through memory but the block's columns.
+/// Out: S.dvol, S.de, S.s_old = S.s (rotated deviator), S.P_old; b.rho at the new volume.
+void kinematics(MaterialBlock& b, BlockScratch& S) {
   const double dt = b.dt;
-  // Kinematics: strain and spin increments, Jaumann rotation, density (000, eqs. 12-15),
-  // component by component in Voigt order (xx, yy, zz, yz, xz, xy): the rotation term
-  // dW.sigma - sigma.dW of a symmetric sigma and a skew dW is symmetric, 24 products where the
-  // 3x3 matrix products took 54, and nothing goes through memory but the block's columns.
   for (int i = 0; i < b.n; ++i) {
     const Mat3& L = b.L[i];
     const double h = 0.5 * dt;
@@ -365,6 +367,12 @@ void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
     S.dvol[i] = dvol;
     b.rho[i] = b.rho[i] / (1.0 + dvol);  // (000, eq. 14)
   }
+}
+}  // namespace
+
+void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
+  const double dt = b.dt;
+  kinematics(b, S);
 
   // A pressure-dependent strength (HJC) takes the EOS's pressure at the new density and the
   // energy of t^n (exact for an EOS without energy; the energy equation follows below).
@@ -408,6 +416,7 @@ void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
       p[i] = std::max(es.pressure(S.A[i], S.B[i], e_star[i]), 0.0);
     }
   const double G43 = 4.0 / 3.0 * G_, c2_rest = K0_eos_ / spec_.density;
+  const double yield_none = 1e-9 * G_;  // a flow stress below this is round-off of a zero one
   for (int i = 0; i < n; ++i) {
     const double rho = b.rho[i], P = p[i] + q[i];
     b.e[i] = e_star[i] - P * k[i];
@@ -423,8 +432,16 @@ void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
     // rho0, where waves start at the EOS's bulk speed there. Without this its G / rho and the
     // EOS's floor under K made the expanding debris of V4 (rho ~ rho0 / 300) set the step
     // with 21 km/s where no wave can run.
+    // A particle whose flow stress is zero after the step (HJC concrete fully damaged at zero
+    // pressure or in tension) carries no shear stress now, but gains strength as soon as it is
+    // compressed again: its shear term is kept, at the density it would regain it, rho0, not
+    // its own. Without that, such debris of V5 flung off the slab's rear face at rho0 / 3000
+    // set a step of 22 ns (sqrt(4G / 3 rho) = 130 km/s); without any shear term, runs on 8 mm
+    // cells went unstable where debris was recompressed.
     const bool failed_now = failure && b.failed[i];
-    double c2 = (K_s + (failed_now ? 0.0 : G43)) / rho;
+    double c2 = failed_now                                        ? K_s / rho
+                : S.yield[i] > yield_none || rho >= spec_.density ? (K_s + G43) / rho
+                                                                  : K_s / rho + G43 / spec_.density;
     if (failed_now && p[i] <= 0 && q[i] <= 0) c2 = std::min(c2, c2_rest);
     const double c = std::sqrt(c2);
     const double trD = S.dvol[i] / dt;
