@@ -434,10 +434,10 @@ void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
     // with 21 km/s where no wave can run.
     // A particle whose flow stress is zero after the step (HJC concrete fully damaged at zero
     // pressure or in tension) carries no shear stress now, but gains strength as soon as it is
-    // compressed again: its shear term is kept, at the density it would regain it, rho0, not
-    // its own. Without that, such debris of V5 flung off the slab's rear face at rho0 / 3000
-    // set a step of 22 ns (sqrt(4G / 3 rho) = 130 km/s); without any shear term, runs on 8 mm
-    // cells went unstable where debris was recompressed.
+    // compressed again: its shear term is kept (the step stays as short as the intact
+    // material's, for debris that is recompressed), at the density it would regain it at,
+    // rho0, not its own. With its own, such debris of V5 flung off the slab's rear face at
+    // rho0 / 3000 set a step of 22 ns (sqrt(4G / 3 rho) = 130 km/s).
     const bool failed_now = failure && b.failed[i];
     double c2 = failed_now                                        ? K_s / rho
                 : S.yield[i] > yield_none || rho >= spec_.density ? (K_s + G43) / rho
