@@ -71,7 +71,7 @@ template <bool C>
       // Nodal velocities cached for the particle: its bin's, or its body's field's (contact).
       bool cached = home;
       const Vec<D>*vg_h = vg_c, *v_h = v_c;
-      Vec<D> vg_f[C ? NMAX : 1], v_f[C ? NMAX : 1];
+      Vec<D> vg_f[C ? NMAX : 1], v_f[C ? NMAX : 1], vg_o[NMAX], v_o[NMAX];
       if constexpr (C)
         if (const int f = contact_.field_of(p.body[i])) {
           const auto& fd = contact_.field(f);
@@ -81,20 +81,25 @@ template <bool C>
           }
           cached = true, vg_h = vg_f, v_h = v_f;
         }
-      for (int c = 0; c < nk; ++c) {
-        const Vec<D>& vg = cached ? vg_h[c] : vg_i[nd[c]];
-        L.noalias() += vg * G[c].transpose();
-        if (axi) v_r += N[c] * vg[0];
-        if (move) vbar += N[c] * (cached ? v_h[c] : v_i[nd[c]]);
+      if (!cached) {  // off its bin's cell (or a graded cell's other nodes): gathered here
+        for (int c = 0; c < nk; ++c) vg_o[c] = vg_i[nd[c]];
+        if (move)
+          for (int c = 0; c < nk; ++c) v_o[c] = v_i[nd[c]];
+        vg_h = vg_o, v_h = v_o;
       }
+      // One pass per sum, without a test inside: the compiler keeps each in registers.
+      for (int c = 0; c < nk; ++c) L.noalias() += vg_h[c] * G[c].transpose();
+      if (move)
+        for (int c = 0; c < nk; ++c) vbar += N[c] * v_h[c];
+      if (axi)
+        for (int c = 0; c < nk; ++c) v_r += N[c] * vg_h[c][0];
       if (p.strain) p.strain[i] += dt * L.diagonal();  // for splitting (004, eq. 23)
       if constexpr (kAffine)
         if (p.C) {  // APIC: C_p = B_p D_p^-1 from the velocities v_p came from (Jiang 2015)
           Vec<D> W[NMAX];
           grid_.affine_weights(key, xi, N, G, W);
           Mat<D> Cp = Mat<D>::Zero();
-          for (int c = 0; c < nk; ++c)
-            Cp.noalias() += (cached ? vg_h[c] : vg_i[nd[c]]) * W[c].transpose();
+          for (int c = 0; c < nk; ++c) Cp.noalias() += vg_h[c] * W[c].transpose();
           p.C[i] = Cp;
         }
       if (pb.ends_before(i, p.material[i], h_cell)) {

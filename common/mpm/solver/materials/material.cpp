@@ -121,6 +121,7 @@ Material::Material(const MaterialSpec& spec, const SolverSpec& solver)
   eos_ = e->second(spec);
   double rho0 = spec.density, e0 = 0, A, B;
   eos_->coefficients(1, &rho0, &e0, &A, &B, &K0_eos_);
+  fused_ = FusedModel::of(spec, solver);
 }
 
 double Material::reference_wave_speed() const {
@@ -158,6 +159,11 @@ double Material::shocked_signal_speed(double u_p) const {
 }
 
 void Material::update(MaterialBlock& b, BlockScratch& S) const {
+  if (fused() && !b.plane_stress && update_fused(b)) return;
+  update_composed(b, S);
+}
+
+void Material::update_composed(MaterialBlock& b, BlockScratch& S) const {
   if (b.plane_stress)
     update_plane_stress(b, S);
   else

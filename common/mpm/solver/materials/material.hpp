@@ -144,6 +144,25 @@ class Strength {
   virtual double flow_stress(double eps_p, double rate, double T) const = 0;
 };
 
+/// The constants of a composition that the fused update runs (fused.cpp): an elastic or
+/// linear-hardening J2 strength (j2 and johnson-cook with n = 1 and neither rate nor thermal
+/// term, bilinear) with a linear or Mie-Grueneisen EOS, and no failure rule. Any other
+/// composition has strength None and takes the composed update.
+struct FusedModel {
+  enum class Strength : std::uint8_t { None, Elastic, LinearHardening };
+  Strength strength = Strength::None;
+  bool mie_gruneisen = false;                    ///< else the linear EOS
+  double G = 0;                                  ///< shear modulus, Pa
+  double A = 0, B = 0;                           ///< flow stress A + B eps_p, Pa
+  double rho0 = 0;                               ///< kg/m^3
+  double K = 0;                                  ///< linear EOS: bulk modulus, Pa
+  double k0 = 0, s = 0, gamma0 = 0, mu_max = 0;  ///< Mie-Grueneisen: rho0 c0^2, s, gamma0, cap
+  bool energy_in_expansion = true;
+  double bulk_linear = 0, bulk_quadratic = 0;  ///< artificial bulk viscosity
+  /// The fused composition of a material, or strength None.
+  static FusedModel of(const MaterialSpec& spec, const SolverSpec& solver);
+};
+
 /// A material: reference properties plus its models.
 class Material {
  public:
@@ -158,6 +177,12 @@ class Material {
   /// secant / false-position iteration on sigma_zz = 0 around the whole update (any strength,
   /// EOS and failure).
   void update(MaterialBlock& blk, BlockScratch& S) const;
+  /// The update by composition: strength, EOS and failure objects stage by stage over the
+  /// block (what update() runs when the composition has no fused form, or a block needs what
+  /// the fused form leaves out: a failed particle, an inverted volume, plane stress).
+  void update_composed(MaterialBlock& blk, BlockScratch& S) const;
+  /// True when this material's composition has the fused update (FusedModel).
+  bool fused() const { return fused_.strength != FusedModel::Strength::None; }
   /// Cap on the update passes of a plane-stress block (the first updates the whole block, the
   /// later ones the particles still iterating).
   static constexpr int kPlaneStressMaxPasses = 30;
@@ -176,6 +201,9 @@ class Material {
 
  private:
   void update_once(MaterialBlock& blk, BlockScratch& S) const;
+  /// The fused update of a block (fused.cpp); false, with the block untouched, when the block
+  /// needs the composed one.
+  bool update_fused(MaterialBlock& blk) const;
   /// One particle's energy equation over a step (material.cpp).
   struct EnergyStep {
     double q = 0;      ///< bulk viscosity, Pa
@@ -203,6 +231,7 @@ class Material {
   double bulk_linear_ = 0, bulk_quadratic_ = 0;
   std::unique_ptr<Strength> strength_;
   std::unique_ptr<Eos> eos_;
+  FusedModel fused_;
 };
 
 /// Factories by name. One explicit function registers the built-in models
