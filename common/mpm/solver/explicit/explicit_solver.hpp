@@ -7,9 +7,11 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <type_traits>
 #include <vector>
 
 #include "mpm/grid/grid.hpp"
+#include "mpm/grid/sparse_grid.hpp"
 #include "mpm/scene/scene.hpp"
 #include "mpm/solver/core.hpp"
 #include "mpm/solver/explicit/contact_fields.hpp"
@@ -181,6 +183,26 @@ class ExplicitSolver : public SolverCore<GridT> {
   template <bool C>
   void stress_chunk(const ParticleView<D>& p, int ch, const Vec<D>* vg_i, Positions positions,
                     bool remapped, ChunkSums& s);
+  template <bool C>
+  void general_sums(const ParticleView<D>& p, std::uint32_t i, std::int64_t bin_key,
+                    const std::int64_t* nodes, int nn, std::int64_t* other, const Vec<D>* vg_i,
+                    const Vec<D>* v_c, const Vec<D>* vg_c, bool move, bool remapped, Mat<D>& L,
+                    Vec<D>& vbar, double& v_r);
+  /// Uniform and sparse 3D cells: trilinear shape functions, whose sums trilinear_sums takes
+  /// across the particles of a bin (stress.hpp).
+  static constexpr bool kTrilinear =
+      std::is_same_v<GridT, UniformGrid<3>> || std::is_same_v<GridT, SparseGrid<3>>;
+  /// The velocity gradients (L(r, c) in L[3 r + c]) and move velocities of a bin's particles,
+  /// one array per component, and which of them are still in the bin's cell.
+  struct TrilinearBin {
+    static constexpr int kMax = 32;  ///< larger bins take the general sums
+    alignas(64) double x[3][kMax];   ///< local coordinates in the bin's cell
+    alignas(64) double L[9][kMax];
+    alignas(64) double v[3][kMax];
+    bool home[kMax];
+  };
+  void trilinear_sums(const ParticleView<D>& p, const Bin& bin, const Vec<D>* vg, const Vec<D>* v,
+                      TrilinearBin& tb) const;
   struct SplitScan;
   SplitScan scan_for_splits() requires GridT::kGraded;
   void write_children(const SplitScan& scan, std::size_t n) requires GridT::kGraded;

@@ -45,6 +45,7 @@ template <bool C>
   const double dt = dt_;
   const bool axi = axisymmetric_, move = positions == Positions::Move;
   PendingBlock pb;
+  TrilinearBin tb;
   for (std::uint32_t bi = chunks[ch].bin_begin; bi < chunks[ch].bin_end; ++bi) {
     const Bin& bin = bins[bi];
     std::int64_t nodes[NMAX], other[NMAX];
@@ -55,59 +56,37 @@ template <bool C>
       if (move) v_c[c] = v_i[nodes[c]];
     }
     const double h_cell = grid_.cell_size(bin.key);
+    // Uniform and sparse 3D cells: the bin's particles still in its cell take their velocity
+    // gradient and move velocity from trilinear_sums, a vector of particles at a time.
+    const bool fast =
+        kTrilinear && !C && !axi && !p.C && !p.strain && bin.end - bin.begin <= TrilinearBin::kMax;
+    if (fast) trilinear_sums(p, bin, vg_c, move ? v_c : nullptr, tb);
     for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
       if (p.material[i] >= kRebarNode) [[unlikely]] {  // rigid particles and rebar nodes
         if (move) move_unstressed(p, i, bin.key, nodes, nn, C ? nullptr : v_c, s);
         continue;
       }
-      const auto [key, xi, home, nk, nd] = locate_in_bin(bin.key, nodes, nn, p.x[i], other);
-      double N[NMAX];
-      Vec<D> G[NMAX];
-      grid_.shape(key, xi, N, G);
-      // Velocity gradient L = sum_i v_i (x) G_ip (000, eqs. 12-13 use its parts).
-      Mat<D> L = Mat<D>::Zero();
-      Vec<D> vbar = Vec<D>::Zero();
+      Mat<D> L;
+      Vec<D> vbar;
       double v_r = 0;
-      // Nodal velocities cached for the particle: its bin's, or its body's field's (contact).
-      bool cached = home;
-      const Vec<D>*vg_h = vg_c, *v_h = v_c;
-      Vec<D> vg_f[C ? NMAX : 1], v_f[C ? NMAX : 1], vg_o[NMAX], v_o[NMAX];
-      if constexpr (C)
-        if (const int f = contact_.field_of(p.body[i])) {
-          const auto& fd = contact_.field(f);
-          for (int c = 0; c < nk; ++c) {
-            vg_f[c] = remapped ? fd.q[nd[c]] : fd.v[nd[c]];
-            v_f[c] = fd.v[nd[c]];
+      if (const int j = int(i - bin.begin); fast && tb.home[j]) {
+        if constexpr (kTrilinear)
+          for (int r = 0; r < 3; ++r) {
+            for (int c = 0; c < 3; ++c) L(r, c) = tb.L[3 * r + c][j];
+            vbar[r] = tb.v[r][j];
           }
-          cached = true, vg_h = vg_f, v_h = v_f;
-        }
-      if (!cached) {  // off its bin's cell (or a graded cell's other nodes): gathered here
-        for (int c = 0; c < nk; ++c) vg_o[c] = vg_i[nd[c]];
-        if (move)
-          for (int c = 0; c < nk; ++c) v_o[c] = v_i[nd[c]];
-        vg_h = vg_o, v_h = v_o;
+      } else {
+        general_sums<C>(p, i, bin.key, nodes, nn, other, vg_i, v_c, vg_c, move, remapped, L, vbar,
+                        v_r);
       }
-      // One pass per sum, without a test inside: the compiler keeps each in registers.
-      for (int c = 0; c < nk; ++c) L.noalias() += vg_h[c] * G[c].transpose();
-      if (move)
-        for (int c = 0; c < nk; ++c) vbar += N[c] * v_h[c];
-      if (axi)
-        for (int c = 0; c < nk; ++c) v_r += N[c] * vg_h[c][0];
-      if (p.strain) p.strain[i] += dt * L.diagonal();  // for splitting (004, eq. 23)
-      if constexpr (kAffine)
-        if (p.C) {  // APIC: C_p = B_p D_p^-1 from the velocities v_p came from (Jiang 2015)
-          Vec<D> W[NMAX];
-          grid_.affine_weights(key, xi, N, G, W);
-          Mat<D> Cp = Mat<D>::Zero();
-          for (int c = 0; c < nk; ++c) Cp.noalias() += vg_h[c] * W[c].transpose();
-          p.C[i] = Cp;
-        }
       if (pb.ends_before(i, p.material[i], h_cell)) {
         stress_block(p, pb, scr, s);
         pb.restart(i, p.material[i], h_cell);
       }
-      scr.L[pb.k].setZero();
-      scr.L[pb.k].template topLeftCorner<D, D>() = L;
+      if constexpr (D == 3)
+        scr.L[pb.k] = L;
+      else
+        scr.L[pb.k].setZero(), scr.L[pb.k].template topLeftCorner<D, D>() = L;
       if (axi) scr.L[pb.k](2, 2) = v_r / p.x[i][0];  // hoop rate
       ++pb.k;
       if (move) {
@@ -118,6 +97,123 @@ template <bool C>
     }
   }
   stress_block(p, pb, scr, s);
+}
+
+/// The velocity gradient L = sum_i v_i (x) G_ip (000, eqs. 12-13 use its parts), the move
+/// velocity sum_i N_ip v_i and (axisymmetric) the hoop rate's v_r of particle i from its cell's
+/// nodes, with any shape functions; also its strain (graded grids) and APIC's C_p.
+template <Grid GridT>
+template <bool C>
+[[gnu::always_inline]] inline void ExplicitSolver<GridT>::general_sums(
+    const ParticleView<D>& p, std::uint32_t i, std::int64_t bin_key, const std::int64_t* nodes,
+    int nn, std::int64_t* other, const Vec<D>* vg_i, const Vec<D>* v_c, const Vec<D>* vg_c,
+    bool move, bool remapped, Mat<D>& L, Vec<D>& vbar, double& v_r) {
+  const double dt = dt_;
+  const bool axi = axisymmetric_;
+  const Vec<D>* v_i = grid_.v.data();
+  {
+    const auto [key, xi, home, nk, nd] = locate_in_bin(bin_key, nodes, nn, p.x[i], other);
+    double N[NMAX];
+    Vec<D> G[NMAX];
+    grid_.shape(key, xi, N, G);
+    L.setZero();
+    vbar.setZero();
+    // Nodal velocities cached for the particle: its bin's, or its body's field's (contact).
+    bool cached = home;
+    const Vec<D>*vg_h = vg_c, *v_h = v_c;
+    Vec<D> vg_f[C ? NMAX : 1], v_f[C ? NMAX : 1], vg_o[NMAX], v_o[NMAX];
+    if constexpr (C)
+      if (const int f = contact_.field_of(p.body[i])) {
+        const auto& fd = contact_.field(f);
+        for (int c = 0; c < nk; ++c) {
+          vg_f[c] = remapped ? fd.q[nd[c]] : fd.v[nd[c]];
+          v_f[c] = fd.v[nd[c]];
+        }
+        cached = true, vg_h = vg_f, v_h = v_f;
+      }
+    if (!cached) {  // off its bin's cell (or a graded cell's other nodes): gathered here
+      for (int c = 0; c < nk; ++c) vg_o[c] = vg_i[nd[c]];
+      if (move)
+        for (int c = 0; c < nk; ++c) v_o[c] = v_i[nd[c]];
+      vg_h = vg_o, v_h = v_o;
+    }
+    // One pass per sum, without a test inside: the compiler keeps each in registers.
+    for (int c = 0; c < nk; ++c) L.noalias() += vg_h[c] * G[c].transpose();
+    if (move)
+      for (int c = 0; c < nk; ++c) vbar += N[c] * v_h[c];
+    if (axi)
+      for (int c = 0; c < nk; ++c) v_r += N[c] * vg_h[c][0];
+    if (p.strain) p.strain[i] += dt * L.diagonal();  // for splitting (004, eq. 23)
+    if constexpr (kAffine)
+      if (p.C) {  // APIC: C_p = B_p D_p^-1 from the velocities v_p came from (Jiang 2015)
+        Vec<D> W[NMAX];
+        grid_.affine_weights(key, xi, N, G, W);
+        Mat<D> Cp = Mat<D>::Zero();
+        for (int c = 0; c < nk; ++c) Cp.noalias() += vg_h[c] * W[c].transpose();
+        p.C[i] = Cp;
+      }
+  }
+}
+
+/// Uniform and sparse 3D cells: which particles of a bin are still in its cell, and for those the
+/// velocity gradient and (v given) the move velocity, a vector of particles at a time. With
+/// trilinear weights w_a(0) = 1 - xi_a, w_a(1) = xi_a, column a of L = sum_c v_c (x) G_c is
+/// the bilinear interpolation over the other two axes of the nodal velocity differences
+/// across axis a, divided by h: 36 products a particle where the sum over the 8 nodes took 72.
+template <Grid GridT>
+void ExplicitSolver<GridT>::trilinear_sums(const ParticleView<D>& p, const Bin& bin,
+                                           const Vec<D>* vg, const Vec<D>* v,
+                                           TrilinearBin& tb) const {
+  if constexpr (kTrilinear) {
+    const int n = int(bin.end - bin.begin);
+    for (int j = 0; j < n; ++j) {
+      std::int64_t key;
+      Vec<D> xi;
+      grid_.locate(p.x[bin.begin + j], key, xi);
+      tb.home[j] = key == bin.key;
+      for (int a = 0; a < 3; ++a) tb.x[a][j] = xi[a];
+    }
+    // Corner c = bx + 2 by + 4 bz. Differences across x on the edges e = by + 2 bz, across y
+    // on e = bx + 2 bz, across z on e = bx + 2 by.
+    double dx[3][4], dy[3][4], dz[3][4];
+    for (int e = 0; e < 4; ++e)
+      for (int r = 0; r < 3; ++r) {
+        const int lo = e & 1, hi = e >> 1;
+        dx[r][e] = vg[2 * lo + 4 * hi + 1][r] - vg[2 * lo + 4 * hi][r];
+        dy[r][e] = vg[lo + 4 * hi + 2][r] - vg[lo + 4 * hi][r];
+        dz[r][e] = vg[lo + 2 * hi + 4][r] - vg[lo + 2 * hi][r];
+      }
+    const double ih = grid_.inv_h();
+#pragma omp simd
+    for (int j = 0; j < n; ++j) {
+      const double x1 = tb.x[0][j], y1 = tb.x[1][j], z1 = tb.x[2][j];
+      const double x0 = 1.0 - x1, y0 = 1.0 - y1, z0 = 1.0 - z1;
+      const double yz[4] = {y0 * z0, y1 * z0, y0 * z1, y1 * z1};
+      const double xz[4] = {x0 * z0, x1 * z0, x0 * z1, x1 * z1};
+      const double xy[4] = {x0 * y0, x1 * y0, x0 * y1, x1 * y1};
+      for (int r = 0; r < 3; ++r) {
+        tb.L[3 * r + 0][j] =
+            ih * (yz[0] * dx[r][0] + yz[1] * dx[r][1] + yz[2] * dx[r][2] + yz[3] * dx[r][3]);
+        tb.L[3 * r + 1][j] =
+            ih * (xz[0] * dy[r][0] + xz[1] * dy[r][1] + xz[2] * dy[r][2] + xz[3] * dy[r][3]);
+        tb.L[3 * r + 2][j] =
+            ih * (xy[0] * dz[r][0] + xy[1] * dz[r][1] + xy[2] * dz[r][2] + xy[3] * dz[r][3]);
+      }
+    }
+    if (!v) return;
+#pragma omp simd
+    for (int j = 0; j < n; ++j) {
+      const double x1 = tb.x[0][j], y1 = tb.x[1][j], z1 = tb.x[2][j];
+      const double x0 = 1.0 - x1, y0 = 1.0 - y1, z0 = 1.0 - z1;
+      const double N[8] = {x0 * y0 * z0, x1 * y0 * z0, x0 * y1 * z0, x1 * y1 * z0,
+                           x0 * y0 * z1, x1 * y0 * z1, x0 * y1 * z1, x1 * y1 * z1};
+      for (int r = 0; r < 3; ++r) {
+        double sum = 0;
+        for (int c = 0; c < 8; ++c) sum += N[c] * v[c][r];
+        tb.v[r][j] = sum;
+      }
+    }
+  }
 }
 
 /// Rigid particles advance with their own velocity; rebar nodes carry no stress (their
