@@ -57,10 +57,16 @@ struct Bar {
   std::string bytes;
   std::vector<RecordSpan> records;
   std::uint64_t first_checkpoint_end = 0;
-  explicit Bar(const std::string& name) : dir(temp_dir(name)) {
+  /// `end_time`: the scene's 6 us, or longer (a run that a signal must reach mid-run).
+  explicit Bar(const std::string& name, const std::string& end_time = "6 us")
+      : dir(temp_dir(name)) {
     model = dir / "model.mpm";
     full = dir / "full.mpm";
-    EXPECT_EQ(run(prep + " " + kBar.string() + " -o " + model.string(), dir).status, 0);
+    std::string scene = slurp(kBar);
+    scene.replace(scene.find("end_time = \"6 us\""), 17, "end_time = \"" + end_time + "\"");
+    std::ofstream(dir / "bar.toml") << scene;
+    EXPECT_EQ(run(prep + " " + (dir / "bar.toml").string() + " -o " + model.string(), dir).status,
+              0);
     const Result r = run(
         runner + " " + model.string() + " --threads 1 --progress none -o " + full.string(), dir);
     EXPECT_EQ(r.status, 0) << r.err;
@@ -222,7 +228,9 @@ TEST(Restart, KilledWithSigkillContinuesBitwise) {
 // how to continue; the continued run has bitwise the frames and history rows of the
 // uninterrupted one (the file differs by the extra checkpoint and where HIST blocks break).
 TEST(Restart, SigtermStopsAfterACheckpointAndContinues) {
-  const Bar bar("restart_sigterm");
+  // Ten times the steps: the signal, sent when the first frame is on disk (polled every 5 ms),
+  // must find the run still going on a loaded machine (the 6 us run takes some 50 ms).
+  const Bar bar("restart_sigterm", "60 us");
   const fs::path out = bar.dir / "stopped.mpm";
   const std::uint64_t first_frame = bar.records[3].end;  // SCEN, INFO, HIST, FRAM
   Result r = run(run_and_signal(bar.model, out, first_frame, "TERM"), bar.dir);

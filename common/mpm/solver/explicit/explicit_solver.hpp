@@ -111,6 +111,11 @@ class ExplicitSolver : public SolverCore<GridT> {
   void scatter_to_grid();
   template <G2pMode M, bool C>
   void gather_from_grid();
+  /// A particle of a body in contact in a bin's scatter: add_to_field, or a stray.
+  template <int F>
+  void add_in_bin(const ParticleView<D>& p, std::uint32_t i, int f, std::int64_t bin_key,
+                  std::int64_t key, const Vec<D>& xi, const std::int64_t* nodes, int nn, int layer,
+                  std::vector<std::uint32_t>* strays);
   /// Particle i (of a body in contact, field f) adds mass, momentum, mass gradient (F has
   /// kMass) and force (F has kForce) to its field at the nodes nd of its cell `key`.
   template <int F>
@@ -203,6 +208,17 @@ class ExplicitSolver : public SolverCore<GridT> {
   };
   void trilinear_sums(const ParticleView<D>& p, const Bin& bin, const Vec<D>* vg, const Vec<D>* v,
                       TrilinearBin& tb) const;
+  /// p2g's sums over a bin's particles in its cell (p2g.hpp): mass and momentum and body force
+  /// by corner, the stress by axis, component and edge along the axis.
+  struct TrilinearSums {
+    double m[8], p[3][8], b[3][8], s[3][3][4];
+    void clear() { *this = TrilinearSums{}; }
+  };
+  template <int F>
+  void trilinear_add(const ParticleView<D>& p, std::uint32_t i, const Vec<D>& xi,
+                     TrilinearSums& ts) const;
+  template <int F>
+  void trilinear_corners(const TrilinearSums& ts, double* m_c, Vec<D>* p_c, Vec<D>* f_c) const;
   struct SplitScan;
   SplitScan scan_for_splits() requires GridT::kGraded;
   void write_children(const SplitScan& scan, std::size_t n) requires GridT::kGraded;

@@ -121,24 +121,24 @@ void ExplicitSolver<GridT>::scatter_to_grid() {
       if constexpr (kP) p_c[c] += dp;
       if constexpr (kF) f_c[c] += df;
     };
+    // Uniform and sparse 3D cells: the particles in the bin's cell add into sums by corner and
+    // by edge (trilinear_add), shared out to the corners at the end (trilinear_corners).
+    const bool trilinear = kTrilinear && !C && !axi && !(kAffine && kP && p.C);
+    TrilinearSums ts{};
     for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
       if (rigid(i)) continue;
       std::int64_t key;
       Vec<D> xi;
       locate_in_bin(bin.key, p.x[i], key, xi);
-      if constexpr (C) {
+      if (trilinear && key == bin.key) {
+        trilinear_add<F>(p, i, xi, ts);
+        continue;
+      }
+      if constexpr (C)
         if (const int f = contact_.field_of(p.body[i])) {
-          if (key == bin.key || !strays || grid_.layer(key) == layer) {
-            std::int64_t other[NMAX];
-            const bool home = key == bin.key;
-            const int nk = home ? nn : grid_.cell_nodes(key, other);
-            add_to_field<F>(p, i, f, key, xi, home ? nodes : other, nk);
-          } else {
-            strays->push_back(i);
-          }
+          add_in_bin<F>(p, i, f, bin.key, key, xi, nodes, nn, layer, strays);
           continue;
         }
-      }
       if (key == bin.key) {
         contribute(i, key, xi, nn, to_cell);
       } else if (!strays || grid_.layer(key) == layer) {
@@ -149,6 +149,7 @@ void ExplicitSolver<GridT>::scatter_to_grid() {
         strays->push_back(i);
       }
     }
+    if (trilinear) trilinear_corners<F>(ts, m_c, p_c, f_c);
     for (int c = 0; c < nn; ++c) {
       const std::int64_t n = nodes[c] - t.offset;
       if constexpr (kM) t.m[n] += m_c[c];
@@ -157,6 +158,97 @@ void ExplicitSolver<GridT>::scatter_to_grid() {
     }
   };
   scatter(F, bin_body, particle_body);  // scatter.hpp
+}
+
+/// Uniform and sparse 3D cells: particle i's mass, momentum and force into the bin's sums.
+/// With trilinear weights N_c = w_x w_y w_z, the force -V sigma G_c on corner c is, along
+/// axis a, -/+ (1/h) V sigma(:, a) times the product of the other two weights, which is the
+/// same for the two corners of an edge along a: the particle adds 3 x 3 x 4 products into
+/// the edges' sums (trilinear_corners shares them out) where the corners took 8 x 9.
+template <Grid GridT>
+template <int F>
+[[gnu::always_inline]] inline void ExplicitSolver<GridT>::trilinear_add(const ParticleView<D>& p,
+                                                                        std::uint32_t i,
+                                                                        const Vec<D>& xi,
+                                                                        TrilinearSums& ts) const {
+  if constexpr (kTrilinear) {
+    const double w[3][2] = {{1.0 - xi[0], xi[0]}, {1.0 - xi[1], xi[1]}, {1.0 - xi[2], xi[2]}};
+    double N[8];
+    for (int c = 0; c < 8; ++c) N[c] = w[0][c & 1] * w[1][(c >> 1) & 1] * w[2][c >> 2];
+    const double m_p = p.m[i];
+    if constexpr (F & kMass)
+      for (int c = 0; c < 8; ++c) ts.m[c] += m_p * N[c];
+    if constexpr (F & kMomentum)
+      for (int r = 0; r < 3; ++r) {
+        const double mv = m_p * p.v[i][r];
+        for (int c = 0; c < 8; ++c) ts.p[r][c] += mv * N[c];
+      }
+    if constexpr (F & kForce) {
+      const double V = m_p / p.rho[i];
+      const Sym& sg = p.sigma[i];
+      const double Vs[3][3] = {{V * sg[0], V * sg[5], V * sg[4]},
+                               {V * sg[5], V * sg[1], V * sg[3]},
+                               {V * sg[4], V * sg[3], V * sg[2]}};
+      // The other two axes' weights on the edges along each axis a: along x, e = by + 2 bz;
+      // along y, e = bx + 2 bz; along z, e = bx + 2 by.
+      double W[3][4];
+      for (int e = 0; e < 4; ++e) {
+        W[0][e] = w[1][e & 1] * w[2][e >> 1];
+        W[1][e] = w[0][e & 1] * w[2][e >> 1];
+        W[2][e] = w[0][e & 1] * w[1][e >> 1];
+      }
+      for (int a = 0; a < 3; ++a)
+        for (int r = 0; r < 3; ++r)
+          for (int e = 0; e < 4; ++e) ts.s[a][r][e] += Vs[r][a] * W[a][e];
+      Vec<D> fb = m_p * gravity_;
+      if (p.f_ext) fb += p.f_ext[i];
+      if (p.f_rebar) fb += p.f_rebar[i];
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 8; ++c) ts.b[r][c] += fb[r] * N[c];
+    }
+  }
+}
+
+/// The bin's trilinear sums shared out to its corners: mass and momentum as summed, the force
+/// N fb - (1/h) sum_a sign_a(c) s_a(edge of c along a) (sign -1 at the lower corner).
+template <Grid GridT>
+template <int F>
+void ExplicitSolver<GridT>::trilinear_corners(const TrilinearSums& ts, double* m_c, Vec<D>* p_c,
+                                              Vec<D>* f_c) const {
+  if constexpr (kTrilinear) {
+    const double ih = grid_.inv_h();
+    for (int c = 0; c < 8; ++c) {
+      const int bx = c & 1, by = (c >> 1) & 1, bz = c >> 2;
+      if constexpr (F & kMass) m_c[c] += ts.m[c];
+      for (int r = 0; r < 3; ++r) {
+        if constexpr (F & kMomentum) p_c[c][r] += ts.p[r][c];
+        if constexpr (F & kForce) {
+          const double gx = bx ? ts.s[0][r][by + 2 * bz] : -ts.s[0][r][by + 2 * bz];
+          const double gy = by ? ts.s[1][r][bx + 2 * bz] : -ts.s[1][r][bx + 2 * bz];
+          const double gz = bz ? ts.s[2][r][bx + 2 * by] : -ts.s[2][r][bx + 2 * by];
+          f_c[c][r] += ts.b[r][c] - ih * (gx + gy + gz);
+        }
+      }
+    }
+  }
+}
+
+/// A particle of a body in contact, in a bin's scatter: into its body's field at its cell's
+/// nodes, or a stray when that cell is in another layer (scatter.hpp).
+template <Grid GridT>
+template <int F>
+void ExplicitSolver<GridT>::add_in_bin(const ParticleView<D>& p, std::uint32_t i, int f,
+                                       std::int64_t bin_key, std::int64_t key, const Vec<D>& xi,
+                                       const std::int64_t* nodes, int nn, int layer,
+                                       std::vector<std::uint32_t>* strays) {
+  if (key != bin_key && strays && grid_.layer(key) != layer) {
+    strays->push_back(i);
+    return;
+  }
+  std::int64_t other[NMAX];
+  const bool home = key == bin_key;
+  const int nk = home ? nn : grid_.cell_nodes(key, other);
+  add_to_field<F>(p, i, f, key, xi, home ? nodes : other, nk);
 }
 
 template <Grid GridT>
