@@ -62,17 +62,16 @@ FusedModel FusedModel::of(const MaterialSpec& spec, const SolverSpec& solver) {
 
 namespace {
 
-/// The block's columns, one array per component.
+/// The block's velocity gradients and stresses, one array per component (the density, energy,
+/// plastic strain and signal speed are columns of the block already).
 struct Columns {
   alignas(64) double L[9][kBlock];  // L(r, c) in [3 r + c]
   alignas(64) double sig[6][kBlock];
-  alignas(64) double rho[kBlock], e[kBlock], ep[kBlock], c[kBlock];
 };
 
-/// The update of the block's columns X; false when a particle's volume would invert
-/// (1 + tr(D) dt <= 0), X then partly updated.
+/// The update of the block: stresses in X, the rest in the block's columns.
 template <bool kPlastic, bool kMieGruneisen>
-bool fused_block(const FusedModel& f, const MaterialBlock& b, Columns& X) {
+void fused_block(const FusedModel& f, MaterialBlock& b, Columns& X) {
   const int n = b.n;
   const double dt = b.dt, hdt = 0.5 * dt, bh = b.h;
   const double G2 = 2.0 * f.G, G3 = 3.0 * f.G, G43 = 4.0 / 3.0 * f.G;
@@ -82,8 +81,11 @@ bool fused_block(const FusedModel& f, const MaterialBlock& b, Columns& X) {
   const double bl = f.bulk_linear, bq = f.bulk_quadratic;
   const double yield_none = 1e-9 * f.G;
   const double B_exp = f.energy_in_expansion ? B_mg : 0.0;  // in expansion
-  double worst = 1.0;                                       // the smallest 1 + tr(D) dt
-#pragma omp simd reduction(min : worst)
+  double* __restrict rho_p = b.rho;
+  double* __restrict e_p = b.e;
+  double* __restrict ep_p = kPlastic ? b.eps_p : nullptr;
+  double* __restrict c_p = b.c;
+#pragma omp simd
   for (int i = 0; i < n; ++i) {
     // Kinematics (material.cpp, kinematics()).
     const double dxx = dt * X.L[0][i], dyy = dt * X.L[4][i], dzz = dt * X.L[8][i];
@@ -92,7 +94,6 @@ bool fused_block(const FusedModel& f, const MaterialBlock& b, Columns& X) {
     const double wxy = hdt * (X.L[1][i] - X.L[3][i]), wxz = hdt * (X.L[2][i] - X.L[6][i]),
                  wyz = hdt * (X.L[5][i] - X.L[7][i]);
     const double dvol = dxx + dyy + dzz;
-    worst = std::min(worst, 1.0 + dvol);
     const double sxx = X.sig[0][i], syy = X.sig[1][i], szz = X.sig[2][i], syz = X.sig[3][i],
                  sxz = X.sig[4][i], sxy = X.sig[5][i];
     const double v0 = sxx + 2.0 * (wxy * sxy + wxz * sxz);
@@ -106,7 +107,7 @@ bool fused_block(const FusedModel& f, const MaterialBlock& b, Columns& X) {
     const double o0 = v0 - mean, o1 = v1 - mean, o2 = v2 - mean;  // s_old: o0..o2, v3..v5
     const double dm = dvol / 3.0;
     const double e0 = dxx - dm, e1 = dyy - dm, e2 = dzz - dm;  // de: e0..e2, dyz, dxz, dxy
-    const double rho = X.rho[i] / (1.0 + dvol);
+    const double rho = rho_p[i] / (1.0 + dvol);
     // Strength: elastic predictor and radial return (strength.cpp).
     double t0 = o0 + G2 * e0, t1 = o1 + G2 * e1, t2 = o2 + G2 * e2, t3 = v3 + G2 * dyz,
            t4 = v4 + G2 * dxz, t5 = v5 + G2 * dxy;
@@ -114,14 +115,14 @@ bool fused_block(const FusedModel& f, const MaterialBlock& b, Columns& X) {
     if constexpr (kPlastic) {
       const double q_tr =
           std::sqrt(1.5 * (t0 * t0 + t1 * t1 + t2 * t2 + 2.0 * (t3 * t3 + t4 * t4 + t5 * t5)));
-      const double ep = X.ep[i];
+      const double ep = ep_p[i];
       const double sy0 = A_y + B_y * ep;
       const bool plastic = q_tr > sy0;
       const double dl = plastic ? (q_tr - sy0) / H_ret : 0.0;
       const double sy = q_tr - G3 * dl;
       const double r = plastic ? sy / q_tr : 1.0;
       t0 *= r, t1 *= r, t2 *= r, t3 *= r, t4 *= r, t5 *= r;
-      X.ep[i] = plastic ? ep + dl : ep;
+      ep_p[i] = plastic ? ep + dl : ep;
       yield = plastic ? sy : sy0;
     }
     // Equation of state at the new density: p = A + B e, bulk modulus K (eos.cpp).
@@ -152,22 +153,21 @@ bool fused_block(const FusedModel& f, const MaterialBlock& b, Columns& X) {
     const double v_mid = v_old * (1.0 + 0.5 * dvol);
     const double work = (o0 + t0) * e0 + (o1 + t1) * e1 + (o2 + t2) * e2 +
                         2.0 * ((v3 + t3) * dyz + (v4 + t4) * dxz + (v5 + t5) * dxy);
-    const double e_star = X.e[i] + 0.5 * work * v_mid - P_old * k;
+    const double e_star = e_p[i] + 0.5 * work * v_mid - P_old * k;
     const double p = (A + B * (e_star - q * k)) / (1.0 + B * k);
     const double P = p + q;
-    X.e[i] = e_star - P * k;
+    e_p[i] = e_star - P * k;
     X.sig[0][i] = t0 - P, X.sig[1][i] = t1 - P, X.sig[2][i] = t2 - P;
     X.sig[3][i] = t3, X.sig[4][i] = t4, X.sig[5][i] = t5;
-    X.rho[i] = rho;
+    rho_p[i] = rho;
     // Signal speed for the time step (material.cpp, update_once).
     const double K_s = std::max(K, 0.0) + (p > 0 ? B * p / rho : 0.0);
     const bool strong = !kPlastic || yield > yield_none || rho >= rho0;
     const double c2 = strong ? (K_s + G43) / rho : K_s / rho + G43 / rho0;
     const double c = std::sqrt(c2);
     const double Q = trD < 0 ? bl * c + bq * bh * (-trD) : 0.0;
-    X.c[i] = Q > 0 ? Q + std::sqrt(Q * Q + c * c) : c;
+    c_p[i] = Q > 0 ? Q + std::sqrt(Q * Q + c * c) : c;
   }
-  return worst > 0.0;  // as kinematics() (a NaN gradient shows in the results instead)
 }
 
 }  // namespace
@@ -185,26 +185,25 @@ bool Material::update_fused(MaterialBlock& b) const {
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) X.L[3 * r + c][i] = L[r + 3 * c];
     for (int a = 0; a < 6; ++a) X.sig[a][i] = b.sigma[i][a];
-    X.rho[i] = b.rho[i];
-    X.e[i] = b.e[i];
-    X.ep[i] = plastic ? b.eps_p[i] : 0.0;
   }
+  // A volume that would invert (1 + tr(D) dt <= 0, as kinematics() has it): the composed
+  // update, which reports it (a NaN gradient shows in the results instead).
+  const double dt = b.dt;
+  double worst = 1.0;
+#pragma omp simd reduction(min : worst)
+  for (int i = 0; i < n; ++i)
+    worst = std::min(worst, 1.0 + (dt * X.L[0][i] + dt * X.L[4][i] + dt * X.L[8][i]));
+  if (!(worst > 0.0)) return false;
   const FusedModel& f = fused_;
-  const bool ok = plastic ? (f.mie_gruneisen ? fused_block<true, true>(f, b, X)
-                                             : fused_block<true, false>(f, b, X))
-                          : (f.mie_gruneisen ? fused_block<false, true>(f, b, X)
-                                             : fused_block<false, false>(f, b, X));
-  if (!ok) return false;  // an inverted volume: the composed update reports it, b untouched
-  double sum = 0;         // finite when every value is (or, rarely, overflowing: the scan tells)
+  if (plastic)
+    f.mie_gruneisen ? fused_block<true, true>(f, b, X) : fused_block<true, false>(f, b, X);
+  else
+    f.mie_gruneisen ? fused_block<false, true>(f, b, X) : fused_block<false, false>(f, b, X);
+  double sum = 0;  // finite when every value is (or, rarely, overflowing: the scan tells)
   for (int i = 0; i < n; ++i) {
     for (int a = 0; a < 6; ++a) b.sigma[i][a] = X.sig[a][i], sum += X.sig[a][i];
-    b.rho[i] = X.rho[i];
-    b.e[i] = X.e[i];
-    b.c[i] = X.c[i];
-    sum += X.rho[i] + X.e[i];
+    sum += b.rho[i] + b.e[i];
   }
-  if (plastic)
-    for (int i = 0; i < n; ++i) b.eps_p[i] = X.ep[i];
   if (!std::isfinite(sum) && b.fault_index < 0)
     for (int i = 0; i < n; ++i)
       if (!std::isfinite(b.e[i]) || !b.sigma[i].allFinite() || !std::isfinite(b.rho[i])) {
