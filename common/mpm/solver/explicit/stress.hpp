@@ -111,48 +111,46 @@ template <bool C>
   const double dt = dt_;
   const bool axi = axisymmetric_;
   const Vec<D>* v_i = grid_.v.data();
-  {
-    const auto [key, xi, home, nk, nd] = locate_in_bin(bin_key, nodes, nn, p.x[i], other);
-    double N[NMAX];
-    Vec<D> G[NMAX];
-    grid_.shape(key, xi, N, G);
-    L.setZero();
-    vbar.setZero();
-    // Nodal velocities cached for the particle: its bin's, or its body's field's (contact).
-    bool cached = home;
-    const Vec<D>*vg_h = vg_c, *v_h = v_c;
-    Vec<D> vg_f[C ? NMAX : 1], v_f[C ? NMAX : 1], vg_o[NMAX], v_o[NMAX];
-    if constexpr (C)
-      if (const int f = contact_.field_of(p.body[i])) {
-        const auto& fd = contact_.field(f);
-        for (int c = 0; c < nk; ++c) {
-          vg_f[c] = remapped ? fd.q[nd[c]] : fd.v[nd[c]];
-          v_f[c] = fd.v[nd[c]];
-        }
-        cached = true, vg_h = vg_f, v_h = v_f;
+  const auto [key, xi, home, nk, nd] = locate_in_bin(bin_key, nodes, nn, p.x[i], other);
+  double N[NMAX];
+  Vec<D> G[NMAX];
+  grid_.shape(key, xi, N, G);
+  L.setZero();
+  vbar.setZero();
+  // Nodal velocities cached for the particle: its bin's, or its body's field's (contact).
+  bool cached = home;
+  const Vec<D>*vg_h = vg_c, *v_h = v_c;
+  Vec<D> vg_f[C ? NMAX : 1], v_f[C ? NMAX : 1], vg_o[NMAX], v_o[NMAX];
+  if constexpr (C)
+    if (const int f = contact_.field_of(p.body[i])) {
+      const auto& fd = contact_.field(f);
+      for (int c = 0; c < nk; ++c) {
+        vg_f[c] = remapped ? fd.q[nd[c]] : fd.v[nd[c]];
+        v_f[c] = fd.v[nd[c]];
       }
-    if (!cached) {  // off its bin's cell (or a graded cell's other nodes): gathered here
-      for (int c = 0; c < nk; ++c) vg_o[c] = vg_i[nd[c]];
-      if (move)
-        for (int c = 0; c < nk; ++c) v_o[c] = v_i[nd[c]];
-      vg_h = vg_o, v_h = v_o;
+      cached = true, vg_h = vg_f, v_h = v_f;
     }
-    // One pass per sum, without a test inside: the compiler keeps each in registers.
-    for (int c = 0; c < nk; ++c) L.noalias() += vg_h[c] * G[c].transpose();
+  if (!cached) {  // off its bin's cell (or a graded cell's other nodes): gathered here
+    for (int c = 0; c < nk; ++c) vg_o[c] = vg_i[nd[c]];
     if (move)
-      for (int c = 0; c < nk; ++c) vbar += N[c] * v_h[c];
-    if (axi)
-      for (int c = 0; c < nk; ++c) v_r += N[c] * vg_h[c][0];
-    if (p.strain) p.strain[i] += dt * L.diagonal();  // for splitting (004, eq. 23)
-    if constexpr (kAffine)
-      if (p.C) {  // APIC: C_p = B_p D_p^-1 from the velocities v_p came from (Jiang 2015)
-        Vec<D> W[NMAX];
-        grid_.affine_weights(key, xi, N, G, W);
-        Mat<D> Cp = Mat<D>::Zero();
-        for (int c = 0; c < nk; ++c) Cp.noalias() += vg_h[c] * W[c].transpose();
-        p.C[i] = Cp;
-      }
+      for (int c = 0; c < nk; ++c) v_o[c] = v_i[nd[c]];
+    vg_h = vg_o, v_h = v_o;
   }
+  // One pass per sum, without a test inside: the compiler keeps each in registers.
+  for (int c = 0; c < nk; ++c) L.noalias() += vg_h[c] * G[c].transpose();
+  if (move)
+    for (int c = 0; c < nk; ++c) vbar += N[c] * v_h[c];
+  if (axi)
+    for (int c = 0; c < nk; ++c) v_r += N[c] * vg_h[c][0];
+  if (p.strain) p.strain[i] += dt * L.diagonal();  // for splitting (004, eq. 23)
+  if constexpr (kAffine)
+    if (p.C) {  // APIC: C_p = B_p D_p^-1 from the velocities v_p came from (Jiang 2015)
+      Vec<D> W[NMAX];
+      grid_.affine_weights(key, xi, N, G, W);
+      Mat<D> Cp = Mat<D>::Zero();
+      for (int c = 0; c < nk; ++c) Cp.noalias() += vg_h[c] * W[c].transpose();
+      p.C[i] = Cp;
+    }
 }
 
 /// Uniform and sparse 3D cells: which particles of a bin are still in its cell, and for those the
