@@ -212,7 +212,6 @@ class ExplicitSolver : public SolverCore<GridT> {
   /// by corner, the stress by axis, component and edge along the axis.
   struct TrilinearSums {
     double m[8], p[3][8], b[3][8], s[3][3][4];
-    void clear() { *this = TrilinearSums{}; }
   };
   template <int F>
   void trilinear_add(const ParticleView<D>& p, std::uint32_t i, const Vec<D>& xi,

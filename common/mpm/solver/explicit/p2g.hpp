@@ -174,7 +174,7 @@ template <int F>
   if constexpr (kTrilinear) {
     const double w[3][2] = {{1.0 - xi[0], xi[0]}, {1.0 - xi[1], xi[1]}, {1.0 - xi[2], xi[2]}};
     double N[8];
-    for (int c = 0; c < 8; ++c) N[c] = w[0][c & 1] * w[1][(c >> 1) & 1] * w[2][c >> 2];
+    shape_values<3>(xi, N);
     const double m_p = p.m[i];
     if constexpr (F & kMass)
       for (int c = 0; c < 8; ++c) ts.m[c] += m_p * N[c];

@@ -39,11 +39,8 @@ class MieGruneisenEos final : public Eos {
         c0_(m.eos.c0),
         s_(m.eos.s),
         gamma0_(m.eos.gamma0),
-        energy_in_expansion_(m.eos.energy_in_expansion) {
-    // The Hugoniot is singular at mu = 1/(s - 1); stop 5% short of it (compression ratios
-    // beyond that are outside the fitted shock data anyway).
-    mu_max_ = s_ > 1.0 ? 0.95 / (s_ - 1.0) : 1e9;
-  }
+        mu_max_(mie_gruneisen_mu_cap(m.eos.s)),
+        energy_in_expansion_(m.eos.energy_in_expansion) {}
   void coefficients(int n, const double* rho, const double* /*e*/, double* A, double* B,
                     double* K) const override {
     const double k0 = rho0_ * c0_ * c0_;

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "mpm/solver/materials/material.hpp"
+#include "mpm/solver/materials/models.hpp"
 
 namespace mpm {
 
@@ -28,11 +29,9 @@ FusedModel FusedModel::of(const MaterialSpec& spec, const SolverSpec& solver) {
       if (s.n != 1.0 || s.C != 0.0 || s.m > 0) return f;
       f.strength = Strength::LinearHardening, f.A = s.A, f.B = s.B;
       break;
-    case StrengthModel::Bilinear: {  // as make_bilinear_strength
-      const double E = spec.youngs_modulus, E_T = s.tangent_modulus;
-      f.strength = Strength::LinearHardening, f.A = s.A, f.B = E * E_T / (E - E_T);
+    case StrengthModel::Bilinear:
+      f.strength = Strength::LinearHardening, f.A = s.A, f.B = bilinear_hardening(spec);
       break;
-    }
     default:
       return f;
   }
@@ -53,7 +52,7 @@ FusedModel FusedModel::of(const MaterialSpec& spec, const SolverSpec& solver) {
   f.k0 = spec.density * spec.eos.c0 * spec.eos.c0;
   f.s = spec.eos.s;
   f.gamma0 = spec.eos.gamma0;
-  f.mu_max = spec.eos.s > 1.0 ? 0.95 / (spec.eos.s - 1.0) : 1e9;  // as the EOS's
+  f.mu_max = mie_gruneisen_mu_cap(spec.eos.s);
   f.energy_in_expansion = spec.eos.energy_in_expansion;
   f.bulk_linear = solver.bulk_linear;
   f.bulk_quadratic = solver.bulk_quadratic;
@@ -79,7 +78,7 @@ void fused_block(const FusedModel& f, MaterialBlock& b, Columns& X) {
   const double rho0 = f.rho0, K_lin = f.K, k0 = f.k0, sm1 = f.s - 1.0, g0 = f.gamma0;
   const double mu_max = f.mu_max, B_mg = f.gamma0 * f.rho0;
   const double bl = f.bulk_linear, bq = f.bulk_quadratic;
-  const double yield_none = 1e-9 * f.G;
+  const double yield_none = no_flow_stress(f.G);
   const double B_exp = f.energy_in_expansion ? B_mg : 0.0;  // in expansion
   double* __restrict rho_p = b.rho;
   double* __restrict e_p = b.e;

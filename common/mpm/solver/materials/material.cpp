@@ -422,7 +422,7 @@ void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
       p[i] = std::max(es.pressure(S.A[i], S.B[i], e_star[i]), 0.0);
     }
   const double G43 = 4.0 / 3.0 * G_, c2_rest = K0_eos_ / spec_.density;
-  const double yield_none = 1e-9 * G_;  // a flow stress below this is round-off of a zero one
+  const double yield_none = no_flow_stress(G_);
   for (int i = 0; i < n; ++i) {
     const double rho = b.rho[i], P = p[i] + q[i];
     b.e[i] = e_star[i] - P * k[i];

@@ -24,6 +24,12 @@ inline double stable_time_step(double dt_max, double cfl, double h, double speed
   return std::min(dt_max, speed > 0 ? cfl * h / speed : dt_max);
 }
 
+/// A flow stress (Pa) at or below this, in a material of shear modulus G, is round-off of a
+/// zero one (the time step's test for a particle without strength).
+inline double no_flow_stress(double G) {
+  return 1e-9 * G;
+}
+
 /// Why a particle's update failed (instability diagnosis).
 enum class PointFault : std::uint8_t { None, VolumeInverted, NonFinite };
 

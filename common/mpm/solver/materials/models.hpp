@@ -16,6 +16,14 @@ std::unique_ptr<Strength> make_j2_strength(const MaterialSpec& m);
 std::unique_ptr<Strength> make_johnson_cook_strength(const MaterialSpec& m);
 /// Bilinear elastic-plastic: J2 with sigma_y = A + H eps_p, H = E E_T / (E - E_T).
 std::unique_ptr<Strength> make_bilinear_strength(const MaterialSpec& m);
+/// The bilinear model's hardening modulus H = E E_T / (E - E_T): uniaxial stress, d sigma =
+/// E (d eps - d eps_p) and d sigma = H d eps_p, gives the slope E H / (E + H) = E_T after yield.
+double bilinear_hardening(const MaterialSpec& m);
+/// Mie-Grueneisen's cap on the compression mu: its Hugoniot is singular at mu = 1/(s - 1), and
+/// the EOS stops 5% short of it (compression ratios beyond are outside the fitted shock data).
+inline double mie_gruneisen_mu_cap(double s) {
+  return s > 1.0 ? 0.95 / (s - 1.0) : 1e9;
+}
 /// Holmquist-Johnson-Cook concrete (hjc.cpp): the strength with its damage, and the
 /// three-region pressure with its unloading path and the damaged tension cut-off.
 std::unique_ptr<Strength> make_hjc_strength(const MaterialSpec& m);

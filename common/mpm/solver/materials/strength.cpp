@@ -137,12 +137,13 @@ std::unique_ptr<Strength> make_j2_strength(const MaterialSpec& m) {
 std::unique_ptr<Strength> make_johnson_cook_strength(const MaterialSpec& m) {
   return std::make_unique<PowerLawPlasticity>(m.strength, true);
 }
+double bilinear_hardening(const MaterialSpec& m) {
+  const double E = m.youngs_modulus, E_T = m.strength.tangent_modulus;
+  return E * E_T / (E - E_T);
+}
 std::unique_ptr<Strength> make_bilinear_strength(const MaterialSpec& m) {
-  // Uniaxial stress: d sigma = E (d eps - d eps_p) and d sigma = H d eps_p give the slope
-  // E H / (E + H) after yield; it is E_T for H = E E_T / (E - E_T).
   StrengthSpec s = m.strength;
-  const double E = m.youngs_modulus, E_T = s.tangent_modulus;
-  s.B = E * E_T / (E - E_T);
+  s.B = bilinear_hardening(m);
   s.n = 1.0;
   return std::make_unique<PowerLawPlasticity>(s, false);
 }
