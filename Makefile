@@ -14,7 +14,8 @@ CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
 DEB_PACKAGES = build-essential cmake pkg-config libeigen3-dev libcgal-dev libvtk9-dev \
   libcli11-dev libgtest-dev googletest libtomlplusplus-dev zlib1g-dev xvfb xauth hyperfine \
-  gnuplot-nox python3 bc clang-format ccache libmuparser-dev
+  gnuplot-nox python3 bc clang-format ccache libmuparser-dev \
+  libopenmpi-dev openmpi-bin
 
 .PHONY: all deps build demo test test-long bench study clean format layout test-asan fuzz
 

@@ -37,6 +37,9 @@ CLI::App* add_history(CLI::App& app, mpm::HistoryArgs& a) {
   sub->add_option("input", a.input, "stream, - for stdin")->capture_default_str();
   sub->add_option("-o,--output", a.output, "CSV file, - for stdout")->capture_default_str();
   sub->add_option("--columns", a.columns, "columns to print (default all)")->delimiter(',');
+  sub->add_option("--digits", a.digits, "significant digits (17: every bit of a double)")
+      ->check(CLI::Range(1, 17))
+      ->capture_default_str();
   return sub;
 }
 
@@ -48,6 +51,9 @@ CLI::App* add_particles(CLI::App& app, mpm::ParticlesArgs& a) {
   sub->add_option("--frame", a.frame, "frame index (0 = first) or 'last'")->capture_default_str();
   sub->add_option("--columns", a.columns, "particle columns (default all), e.g. x,sigma")
       ->delimiter(',');
+  sub->add_option("--digits", a.digits, "significant digits (17: every bit of a double)")
+      ->check(CLI::Range(1, 17))
+      ->capture_default_str();
   return sub;
 }
 

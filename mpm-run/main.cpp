@@ -1,21 +1,28 @@
-// mpm-run: the solver. Reads a model stream (from mpm-prep), writes a result stream.
+// mpm-run: the solver. Reads a model stream (from mpm-prep), writes a result stream; alone,
+// or under mpirun as one rank of a domain decomposition (the root reads and writes).
 //   mpm-prep scene.toml | mpm-run --threads 2 --stats | mpm-post taylor -
+//   mpm-prep scene.toml | mpirun -np 2 mpm-run --threads 1 | mpm-post taylor -
 #include <CLI/CLI.hpp>
 #include <cstdio>
 
 #include "mpm/core/cli.hpp"
+#include "mpm/core/comm.hpp"
 #include "mpm/core/error.hpp"
 #include "mpm/core/version.hpp"
 #include "mpm/run/run.hpp"
 
 int main(int argc, char** argv) {
+  mpm::CommSession mpi(argc, argv);  // MPI, when started by mpirun
+  const mpm::Comm& comm = mpm::Comm::world();
   CLI::App app{
       "mpm-run: explicit material point method solver.\n"
       "Reads a model stream (from mpm-prep) and writes a result stream of frames and\n"
       "histories (for mpm-post). Exit status: 0 done, 2 bad input, 3 unstable run,\n"
       "4 write failure, 5 a particle left the domain (solver.on_exit = \"stop\"),\n"
       "128+N stopped by signal N (SIGINT, SIGTERM: after a checkpoint;\n"
-      "continue with --restart RESULT).",
+      "continue with --restart RESULT).\n"
+      "Under mpirun (mpirun -np N mpm-run ...) the ranks share the particles by slabs;\n"
+      "rank 0 reads the model and writes the stream.",
       "mpm-run"};
   mpm::RunOptions opt;
   std::string progress = "auto";
@@ -63,7 +70,7 @@ int main(int argc, char** argv) {
                  : progress == "lines" ? mpm::ProgressMode::Lines
                  : progress == "none"  ? mpm::ProgressMode::None
                                        : mpm::ProgressMode::Auto;
-  return mpm::guarded_main("mpm-run", [&] {
+  auto body = [&] {
     mpm::ignore_sigpipe();
     if (!opt.restart.empty()) {
       if (app.count("input"))
@@ -74,5 +81,24 @@ int main(int argc, char** argv) {
     mpm::check_output_file(opt.output, {opt.input});
     if (!max_memory.empty()) opt.max_memory = mpm::parse_memory_size(max_memory, "--max-memory");
     return mpm::run_model(opt);
-  });
+  };
+  if (!comm.parallel()) return mpm::guarded_main("mpm-run", body);
+  // Under mpirun. Errors in the input reach every rank alike (the root reads the model and
+  // shares what it found): the root reports them. A failure of one rank alone (writing the
+  // stream, an internal error) ends every rank, since the others would wait for it.
+  int status;
+  if (comm.root()) {
+    status = mpm::guarded_main("mpm-run", body);
+  } else {
+    try {
+      status = body();
+    } catch (const mpm::InputError&) {  // the root reports the same error
+      status = mpm::kExitBadInput;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "mpm-run (rank %d): internal error: %s\n", comm.rank(), e.what());
+      status = mpm::kExitInternal;
+    }
+  }
+  if (status == mpm::kExitInternal || status == mpm::kExitIo) comm.abort(status);
+  return status;
 }

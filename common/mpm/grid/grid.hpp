@@ -199,6 +199,8 @@ class CellLattice {
   double h() const { return h_; }
   double inv_h() const { return inv_h_; }
   const Vec<D>& origin() const { return origin_; }
+  /// Cells of the domain along each axis.
+  const IVec<D>& cells() const { return cells_; }
   /// Global cell of a position and the position within it (fractions of h in [0,1)).
   void locate(const Vec<D>& x, IVec<D>& cell, Vec<D>& xi) const {
     const Vec<D> r = (x - origin_) * inv_h_;
@@ -351,6 +353,17 @@ class UniformGrid : public CellLattice<D>, public GridNodes<D> {
   std::int64_t corner(int c) const { return corner_[c]; }
   /// Global node index (lattice numbering) of a window node.
   IVec<D> global_node(std::int64_t index) const;
+  /// The box of global nodes [lo, hi] the window spans (a decomposition's shared nodes).
+  void node_box(IVec<D>& lo, IVec<D>& hi) const { lo = lo_, hi = hi_ + IVec<D>::Ones(); }
+  /// Index of the window node at global node k, -1 when the window has none there.
+  std::int64_t node_at(const IVec<D>& k) const {
+    std::int64_t idx = 0;
+    for (int a = 0; a < D; ++a) {
+      if (k[a] < lo_[a] || k[a] > hi_[a] + 1) return -1;
+      idx += std::int64_t(k[a] - lo_[a]) * stride_[a];
+    }
+    return idx;
+  }
 
   // Node data and constrained nodes: GridNodes.
 

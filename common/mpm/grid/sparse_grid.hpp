@@ -64,6 +64,19 @@ class SparseGrid : public CellLattice<D>, public GridNodes<D> {
   int slab_axis() const { return slab_; }
   /// Cells in the box the active cells lie in (the cell-to-key table's length).
   std::size_t box_cells() const { return cell_key_.size(); }
+  /// The box of global nodes [lo, hi] the active nodes lie in.
+  void node_box(IVec<D>& lo, IVec<D>& hi) const { lo = lo_, hi = hi_ + IVec<D>::Ones(); }
+  /// Index of the active node at global node k (a corner of an active cell), -1 when none.
+  std::int64_t node_at(const IVec<D>& k) const {
+    for (int c = 0; c < kMaxNodes; ++c) {
+      IVec<D> cell = k;
+      for (int a = 0; a < D; ++a) cell[a] -= (c >> a) & 1;
+      if (!in_box(cell)) continue;
+      const std::int32_t key = cell_key_[box_index(cell)];
+      if (key >= 0) return cell_nodes_[std::size_t(key) * kMaxNodes + std::size_t(c)];
+    }
+    return -1;
+  }
 
   // Node data and constrained nodes (the active ones): GridNodes.
 

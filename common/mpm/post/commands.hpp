@@ -26,6 +26,7 @@ struct HistoryArgs {
   std::string input = "-";           ///< stream ("-": stdin)
   std::string output = "-";          ///< CSV file ("-": stdout)
   std::vector<std::string> columns;  ///< history columns to print; empty: all
+  int digits = 10;                   ///< significant digits of the values
 };
 int post_history(const HistoryArgs& args);
 
@@ -44,6 +45,7 @@ struct ParticlesArgs {
   std::string output = "-";          ///< CSV file ("-": stdout)
   std::string frame = "last";        ///< frame index (0 = first) or "last"
   std::vector<std::string> columns;  ///< particle columns; empty: all
+  int digits = 10;                   ///< significant digits of the values
 };
 int post_particles(const ParticlesArgs& args);
 

@@ -1,6 +1,7 @@
 // The JSON writer of mpm-post's --json output.
 #include "mpm/post/json.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 
@@ -60,9 +61,11 @@ JsonWriter& JsonWriter::key(std::string_view name) {
 
 JsonWriter& JsonWriter::number(double v) {
   if (!std::isfinite(v)) return raw("null");
+  // The shortest text that reads back as the same double: every bit, for scripts that
+  // compare runs, and no more digits than that.
   char b[40];
-  std::snprintf(b, sizeof b, "%.10g", v);
-  return raw(b);
+  const auto r = std::to_chars(b, b + sizeof b, v);
+  return raw(std::string_view(b, std::size_t(r.ptr - b)));
 }
 
 JsonWriter& JsonWriter::boolean(bool v) {

@@ -242,7 +242,7 @@ std::vector<const Column*> particle_columns(const Frame& frame,
 /// last column body_name names each particle's body.
 void write_particles_csv(std::FILE* f, const std::string& path, const Frame& frame,
                          const std::vector<const Column*>& picked,
-                         const std::vector<std::string>& body_names) {
+                         const std::vector<std::string>& body_names, int digits) {
   std::fprintf(f, "# t = %.10g s, step %lld\n", frame.time, (long long)frame.step);
   const Column* body = nullptr;
   for (const Column* c : picked)
@@ -261,7 +261,7 @@ void write_particles_csv(std::FILE* f, const std::string& path, const Frame& fra
     bool first = true;
     for (const Column* c : picked)
       for (int k = 0; k < c->info().components; ++k) {
-        std::fprintf(f, "%s%.10g", first ? "" : ",", column_value(*c, i, k));
+        std::fprintf(f, "%s%.*g", first ? "" : ",", digits, column_value(*c, i, k));
         first = false;
       }
     if (body) {
@@ -339,7 +339,7 @@ int post_history(const HistoryArgs& a) {
     const std::size_t nc = h.names.size();
     for (std::size_t r = 0; r < h.rows(); ++r) {
       for (std::size_t k = 0; k < pick.size(); ++k)
-        std::fprintf(f, "%s%.10g", k ? "," : "", h.values[r * nc + pick[k]]);
+        std::fprintf(f, "%s%.*g", k ? "," : "", a.digits, h.values[r * nc + pick[k]]);
       std::fprintf(f, "\n");
       check_written(f, a.output);
     }
@@ -375,7 +375,7 @@ int post_particles(const ParticlesArgs& a) {
   std::vector<std::string> body_names;
   if (!scene_text.empty())
     for (const BodySpec& b : scene_of(scene_text, a.input).bodies) body_names.push_back(b.name);
-  write_particles_csv(f, a.output, *chosen, picked, body_names);
+  write_particles_csv(f, a.output, *chosen, picked, body_names, a.digits);
   close_output(f, a.output);
   return conclude(a.input, s, std::size_t(index));
 }

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "mpm/core/columns.hpp"
+#include "mpm/core/comm.hpp"
 #include "mpm/scene/particles.hpp"
 #include "mpm/scene/scene.hpp"
 #include "mpm/solver/implicit/implicit_solver.hpp"
@@ -88,7 +89,7 @@ class History {
                                k * b.kinetic,     k * b.internal, k * b.external_work,
                                k * b.removed,     k * b.total(),  k * b.leapfrog_total};
     for (int a = 0; a < dim_; ++a) row.push_back(k * b.momentum[a]);
-    row.push_back(double(const_cast<Solver&>(s).particles().size()));
+    row.push_back(double(s.particle_count()));  // every rank's under mpirun
     if (removed_) {
       row.push_back(k * b.removed_mass);
       for (int a = 0; a < dim_; ++a) row.push_back(k * b.removed_momentum[a]);
@@ -131,6 +132,8 @@ class History {
     block_.values.clear();
   }
   std::size_t pending() const { return block_.rows(); }
+  /// Drops the pending rows (under mpirun, on the ranks that do not write the stream).
+  void discard() { block_.values.clear(); }
 
  private:
   void add(const std::string& name, const std::string& unit) {
@@ -180,6 +183,7 @@ class History {
       out[dim_ + 1] += 0.5 * m[i] * v2;
       if (e) out[dim_ + 2] += m[i] * e[i];
     }
+    Comm::world().sum(sum.data(), int(sum.size()));  // every rank's particles, in rank order
     for (double x : sum) row.push_back(factor_ * x);
   }
   int dim_;

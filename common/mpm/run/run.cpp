@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "mpm/core/cli.hpp"
+#include "mpm/core/comm.hpp"
 #include "mpm/core/error.hpp"
 #include "mpm/core/units.hpp"
 #include "mpm/core/version.hpp"
@@ -25,6 +26,7 @@
 #include "mpm/solver/explicit/graded_solver.hpp"
 #include "mpm/solver/explicit/sparse_solver.hpp"
 #include "mpm/solver/implicit/implicit_solver.hpp"
+#include "mpm/solver/ranks.hpp"
 #include "mpm/stream/stream.hpp"
 
 namespace mpm {
@@ -151,9 +153,10 @@ Model read_model(const RunOptions& opt) {
 std::string run_info(const Scene& scene, const Lattice& lat, int threads) {
   std::ostringstream o;
   o << "tool = \"mpm-run\"\nversion = \"" << kVersion << "\"\nthreads = " << threads
-    << "\ndimension = " << scene.dimension << "\n[lattice]\norigin = [" << lat.origin[0] << ", "
-    << lat.origin[1] << ", " << lat.origin[2] << "]\nh = " << lat.h << "\ncells = [" << lat.cells[0]
-    << ", " << lat.cells[1] << ", " << lat.cells[2] << "]\n";
+    << "\nranks = " << Comm::world().size() << "\ndimension = " << scene.dimension
+    << "\n[lattice]\norigin = [" << lat.origin[0] << ", " << lat.origin[1] << ", " << lat.origin[2]
+    << "]\nh = " << lat.h << "\ncells = [" << lat.cells[0] << ", " << lat.cells[1] << ", "
+    << lat.cells[2] << "]\n";
   return o.str();
 }
 
@@ -191,7 +194,7 @@ void print_stats(Solver& solver, int threads, double loop_wall) {
   std::fprintf(stderr,
                "\nstrategy %s, threads %d, particles %zu, steps %ld, sorts %ld, particle-steps "
                "%.4g, %.3f million particle-steps/s\n",
-               strategy.c_str(), threads, solver.particles().size(), solver.steps(),
+               strategy.c_str(), threads, solver.particle_count(), solver.steps(),
                solver.binning().sorts(), ps, wall > 0 ? ps / wall / 1e6 : 0.0);
   if constexpr (GridT::kGraded)
     std::fprintf(stderr, "graded grid: %d levels, %zu cells, %zu nodes; %ld particles split\n",
@@ -260,13 +263,13 @@ class TimeLoop {
       history_.restore(s);
       if constexpr (GridT::kGraded) grid_revision_ = long(s.get("grid_revision_written"));
       checkpoint_.restore(s);
-    } else {
+    } else if (comm_.root()) {  // under mpirun the root writes the stream
       out_ = std::make_unique<StreamWriter>(opt.output,
                                             rebar ? kStreamVersionMinor : kStreamMinorWithoutRebar);
       out_->write_text(RecordType::Scene, scene.toml);
       out_->write_text(RecordType::Info, run_info(scene, lattice, omp_get_max_threads()));
-      next_history_ = o_.history_interval;
     }
+    if (!restart) next_history_ = o_.history_interval;
   }
 
   int operator()();
@@ -282,13 +285,28 @@ class TimeLoop {
                          encode_grid(solver_.grid().mesh(solver_.steps(), solver_.time())));
     }
   }
-  /// The particles as a frame, or in a checkpoint, written without copying them.
+  /// The particles as a frame, or in a checkpoint, written without copying them; under
+  /// mpirun every rank's, gathered at the root in particle-id order (then `gathered` holds
+  /// them until the next frame).
   template <class Write>
   void write_particles(std::uint32_t flags, Write&& write) {
     Frame f;
     f.step = solver_.steps();
     f.time = solver_.time();
     f.flags = flags;
+    if (comm_.parallel()) {
+      gather_by_id(comm_, solver_.particles(), gathered_);
+      if (!comm_.root()) return;
+      std::swap(f.columns, gathered_);
+      try {
+        write(f);
+      } catch (...) {
+        std::swap(f.columns, gathered_);
+        throw;
+      }
+      std::swap(f.columns, gathered_);
+      return;
+    }
     std::swap(f.columns, solver_.particles());
     try {
       write(f);
@@ -300,12 +318,36 @@ class TimeLoop {
   }
   void emit_frame(std::uint32_t flags) {
     ScopedTimer timer(solver_.timers(), t_output_);
-    history_.flush(*out_);
-    write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
+    flush_history();
+    emit_escapes();
     emit_grid();
     write_particles(flags, [&](const Frame& f) { out_->write_frame(f, o_.fields, o_.precision); });
     if (rebar_) write_rebar(flags);  // the elements' state at the frame (after it)
-    extremes_.sample(solver_.particles(), solver_.time());
+    if (!comm_.parallel())
+      extremes_.sample(solver_.particles(), solver_.time());
+    else if (comm_.root())
+      extremes_.sample(gathered_, solver_.time());
+    gathered_ = ColumnStore();
+  }
+  /// History rows to the stream (the root's; the other ranks computed the same rows).
+  void flush_history() {
+    if (out_)
+      history_.flush(*out_);
+    else
+      history_.discard();
+  }
+  /// The particles that left the domain since the last ESCP record; under mpirun every
+  /// rank's, gathered at the root.
+  void emit_escapes() {
+    EscapeLog& log = solver_.escapes();
+    if (comm_.parallel()) {
+      ColumnStore all;
+      gather_by_id(comm_, log.columns(), all);
+      log.clear();
+      if (!comm_.root()) return;
+      if (all.size() > 0) std::swap(log.columns(), all);
+    }
+    write_escapes(*out_, log, solver_.steps(), solver_.time());
   }
   /// A REBR record: the rebar's elements now, written without copying them.
   void write_rebar(std::uint32_t flags) {
@@ -327,8 +369,8 @@ class TimeLoop {
   void write_checkpoint() {
     ScopedTimer timer(solver_.timers(), t_output_);
     solver_.settle();
-    history_.flush(*out_);
-    write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
+    flush_history();
+    emit_escapes();
     StateValues s;
     solver_.save_state(s);
     s.set("frame", frame_);
@@ -344,6 +386,7 @@ class TimeLoop {
   /// once the particles are due for a re-sort (at most kSignalWait steps on), the implicit one
   /// at once (as advance() does).
   bool stop_for_signal() {
+    if (comm_.parallel()) g_signal = int(comm_.max(g_signal));  // every rank stops at once
     if (!g_signal) return false;
     if (!kImplicit && !solver_.sort_pending() && ++signal_wait_ <= kSignalWait) return false;
     write_checkpoint();
@@ -359,13 +402,17 @@ class TimeLoop {
   /// One step and what follows it: history rows, frames, checkpoints.
   void advance();
   void report(double loop_wall) const;
+  /// --stats under mpirun: each rank's particles, shared nodes, and what it sent (collective).
+  std::string rank_stats() const;
 
+  const Comm& comm_ = Comm::world();
   const RunOptions& opt_;
   const OutputSpec& o_;
   const double end_;
   Solver& solver_;
   const Restart* restart_;
-  ColumnStore* rebar_;  ///< the rebar's element table, or null
+  ColumnStore* rebar_;    ///< the rebar's element table, or null
+  ColumnStore gathered_;  ///< under mpirun, at the root: every rank's particles at the last frame
   std::unique_ptr<StreamWriter> out_;
   History history_;
   MaterialExtremes extremes_;  ///< sampled at each frame, reported at the end
@@ -391,7 +438,7 @@ void TimeLoop<Solver>::advance() {
   if (solver_.time() >= next_history_ * (1 - 1e-12) || o_.history_interval <= 0) {
     history_.record(solver_, dt);
     next_history_ += o_.history_interval;
-    if (history_.pending() >= 4096) history_.flush(*out_);
+    if (history_.pending() >= 4096) flush_history();
   }
   if (solver_.time() >= next_frame() * (1 - 1e-12)) {
     history_.record(solver_, dt);  // a row at each frame time (one: record skips a repeat)
@@ -403,7 +450,7 @@ void TimeLoop<Solver>::advance() {
   // without checkpoints); the implicit one's steps are long, and a checkpoint drops its warm
   // start anyway (ImplicitSolver::settle): it writes at once.
   if (solver_.time() < end_ * (1 - 1e-12) &&
-      checkpoint_.write_now(kImplicit || solver_.sort_pending()))
+      comm_.any(checkpoint_.write_now(kImplicit || solver_.sort_pending())))
     write_checkpoint();
 }
 
@@ -416,7 +463,7 @@ int TimeLoop<Solver>::operator()() {
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  Progress progress(opt_.progress, end_);
+  Progress progress(comm_.root() ? opt_.progress : ProgressMode::None, end_);
   const long max_steps = solver_.scene().solver.max_steps;
   const double loop_start = omp_get_wtime();
   try {
@@ -443,16 +490,21 @@ int TimeLoop<Solver>::operator()() {
     message_ = e.what();
   }
   const double loop_wall = omp_get_wtime() - loop_start;  // the time loop, output included
-  history_.flush(*out_);
-  write_escapes(*out_, solver_.escapes(), solver_.steps(), solver_.time());
-  out_->write_end(status_, message_);
-  out_->close();
+  flush_history();
+  emit_escapes();
+  if (out_) {
+    out_->write_end(status_, message_);
+    out_->close();
+  }
+  const std::string ranks = opt_.stats && comm_.parallel() ? rank_stats() : std::string();
   report(loop_wall);
+  if (comm_.root() && !ranks.empty()) std::fputs(ranks.c_str(), stderr);
   return status_;
 }
 
 template <class Solver>
 void TimeLoop<Solver>::report(double loop_wall) const {
+  if (!comm_.root()) return;  // the root speaks for every rank
   if (status_ == kExitUnstable || status_ == kExitLeftDomain) {
     std::fprintf(stderr,
                  "mpm-run: error: %s\nmpm-run: the %d frame(s) written before stay valid "
@@ -466,6 +518,30 @@ void TimeLoop<Solver>::report(double loop_wall) const {
     std::fprintf(stderr, "mpm-run: %zu particles left the domain and were removed\n",
                  solver_.removed_particles());
   if (opt_.stats) print_stats(solver_, omp_get_max_threads(), loop_wall);
+}
+
+template <class Solver>
+std::string TimeLoop<Solver>::rank_stats() const {
+  std::string line;
+  if constexpr (!kImplicit && Solver::kRanks) {
+    const auto* r = solver_.ranks();
+    const double steps = double(std::max(1L, solver_.steps()));
+    char b[400];
+    std::snprintf(b, sizeof b,
+                  "  rank %d: %zu particles, slabs along %c, %.0f shared nodes (last sort), %.0f "
+                  "particles sent away; %.0f bytes and %.1f messages sent a step (%.4g MB, %.0f "
+                  "messages in all)\n",
+                  comm_.rank(), solver_.particles().size(), "xyz"[r ? r->axis() : 0],
+                  r ? r->shared_nodes() : 0.0, r ? r->migrated() : 0.0, comm_.bytes_sent() / steps,
+                  comm_.messages_sent() / steps, comm_.bytes_sent() / 1e6, comm_.messages_sent());
+    line = b;
+  }
+  std::string out;
+  std::vector<std::size_t> at;
+  const std::string all = comm_.gather(line, at);
+  if (comm_.root())
+    out = "ranks " + std::to_string(comm_.size()) + " (domain decomposition, mpirun):\n" + all;
+  return out;
 }
 
 /// --strategy patch works on the dense window of linear weights only; `why` says why not here.
@@ -485,9 +561,28 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
   return loop();
 }
 
+/// Under mpirun: what the domain decomposition does not cover yet, refused before the run.
+void refuse_under_ranks(const Scene& scene, bool rebar) {
+  if (!Comm::world().parallel()) return;
+  const std::string ranks = "under mpirun (" + std::to_string(Comm::world().size()) + " ranks)";
+  auto refuse = [&](const std::string& key, const std::string& what) {
+    throw InputError(key, what + " runs on one process; " + ranks +
+                              " mpm-run decomposes the explicit solver on a uniform or sparse "
+                              "grid with linear shape functions: run this scene without mpirun");
+  };
+  if (scene.solver.type == SolverType::Implicit) refuse("solver.type", "the implicit solver");
+  if (!scene.grid.levels.empty()) refuse("grid.levels", "a graded grid");
+  if (scene.grid.shape != GridShape::Linear) refuse("grid.shape", "a B-spline grid");
+  if (!scene.contacts.empty()) refuse("contact", "a scene with [[contact]]");
+  if (rebar || !scene.rebars.empty()) refuse("rebar", "a scene with [[rebar]]");
+  for (const auto& b : scene.bodies)
+    if (b.rigid) refuse("bodies." + b.name + ".rigid", "a scene with rigid bodies");
+}
+
 template <int D>
 int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame& model,
         const Restart* restart, ColumnStore* rebar = nullptr) {
+  refuse_under_ranks(scene, rebar != nullptr);
   const bool graded = !scene.grid.levels.empty();  // mesh grading (004, section 3)
   if (scene.solver.type == SolverType::Implicit) {
     if (graded)
@@ -568,15 +663,47 @@ int restart_model(const RunOptions& opt) {
 
 }  // namespace
 
+/// Under mpirun: the root reads the model and sends every rank its scene and the particles'
+/// columns (the particles themselves stay at the root until the solver's first sort hands them
+/// to their ranks). A model the root cannot read fails on every rank with its message.
+Model read_model_on_ranks(const RunOptions& opt) {
+  const Comm& comm = Comm::world();
+  Model model;
+  std::string error;
+  if (comm.root()) {
+    try {
+      model = read_model(opt);
+    } catch (const InputError& e) {
+      error = e.what();
+    }
+  }
+  comm.broadcast(error);
+  if (!error.empty()) throw InputError("", error);
+  std::string scene = model.scene_text, schema = pack_schema(model.frame.columns);
+  std::string rebar = model.rebar.columns.columns().empty() ? "" : "rebar";
+  comm.broadcast(scene);
+  comm.broadcast(schema);
+  comm.broadcast(rebar);
+  if (!comm.root()) {
+    model.scene_text = scene;
+    add_schema(model.frame.columns, schema);
+    if (!rebar.empty()) model.rebar.columns.add({"rebar", ScalarType::U8, 1, "-"});
+  }
+  return model;
+}
+
 int run_model(const RunOptions& opt) {
   if (opt.threads > 0) omp_set_num_threads(opt.threads);
+  if (!opt.restart.empty() && Comm::world().parallel())
+    throw InputError("--restart",
+                     "continues a run on one process: run mpm-run --restart without mpirun");
   if (!opt.restart.empty()) return restart_model(opt);
   for (const auto& kv : opt.overrides)
     if (kv.rfind("bodies", 0) == 0)
       throw InputError("--set " + kv.substr(0, kv.find('=')),
                        "bodies are fixed once mpm-prep has made the particles; pass this "
                        "override to mpm-prep instead");
-  Model model = read_model(opt);
+  Model model = Comm::world().parallel() ? read_model_on_ranks(opt) : read_model(opt);
   const std::string name = (opt.input == "-" ? std::string("stdin") : opt.input) + " (scene)";
   const Scene scene = parse_scene(model.scene_text, name, "", opt.overrides);
   const Lattice lattice = make_lattice(scene);

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "mpm/core/columns.hpp"
+#include "mpm/core/comm.hpp"
 #include "mpm/core/error.hpp"
 #include "mpm/core/state_values.hpp"
 #include "mpm/core/timers.hpp"
@@ -26,6 +27,7 @@
 #include "mpm/solver/balance.hpp"
 #include "mpm/solver/escapes.hpp"
 #include "mpm/solver/materials/material.hpp"
+#include "mpm/solver/ranks.hpp"
 
 namespace mpm {
 
@@ -88,9 +90,10 @@ inline void rigid_body_marks(const Scene& scene, std::vector<std::uint8_t>& mark
 
 /// Checks that every particle starts inside the grid's domain (InputError naming the first
 /// that does not) and returns the nodal-mass floor below which a node counts as empty: 1e-14
-/// of the lightest deformable particle.
+/// of the lightest deformable particle (of every rank's, with `comm`).
 template <Grid GridT>
-double check_start_and_mass_floor(const GridT& grid, const ParticleView<GridT::kDim>& p) {
+double check_start_and_mass_floor(const GridT& grid, const ParticleView<GridT::kDim>& p,
+                                  const Comm* comm = nullptr) {
   double m_min = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < p.n; ++i) {
     std::int64_t key;
@@ -100,6 +103,7 @@ double check_start_and_mass_floor(const GridT& grid, const ParticleView<GridT::k
           "model", "particle " + std::to_string(p.id[i]) + " lies outside the domain of the grid");
     if (p.material[i] != kRigidMaterial) m_min = std::min(m_min, p.m[i]);
   }
+  if (comm) m_min = comm->min(m_min);
   return 1e-14 * (std::isfinite(m_min) ? m_min : 1.0);
 }
 
@@ -152,6 +156,16 @@ class SolverCore {
   /// indexed by body.
   const std::vector<Vec3>& rigid_force() const { return rigid_force_; }
   ColumnStore& particles() { return particles_; }
+  /// Particles of the run: this process's, and under mpirun every rank's (particles() holds
+  /// this rank's).
+  std::size_t particle_count() const {
+    if constexpr (kRanks)
+      if (ranks_) return ranks_->total_particles();
+    return particles_.size();
+  }
+  /// The slab decomposition under mpirun (ranks.hpp); null in a run of one process.
+  const RankSlabs<GridT>* ranks() const { return ranks_.get(); }
+  static constexpr bool kRanks = requires(const GridT& g, IVec<D> k) { g.node_at(k); };
   const GridT& grid() const { return grid_; }
   const Binning& binning() const { return binning_; }
   KernelTimers& timers() { return timers_; }
@@ -180,6 +194,8 @@ class SolverCore {
   /// built for the scene; checks that they start in the domain. The columns stay the caller's.
   SolverCore(const Scene& scene, GridT grid, ColumnStore& particles);
   ~SolverCore() = default;
+  /// Under mpirun, rank sums of a balance's change (the particles a sort removed).
+  void reduce_removed(const Balance& d, std::size_t count);
 
   /// Cell order: particles that left the domain are dropped (their energy booked), the grid
   /// window refitted to the others, the columns sorted by cell.
@@ -238,7 +254,8 @@ class SolverCore {
   std::array<double, 6> face_force_{};
   double node_mass_floor_ = 0;                           ///< nodes lighter count as empty
   std::vector<std::unique_ptr<StressScratch>> scratch_;  ///< per thread
-  mutable KernelTimers timers_;  ///< const kernels (residual, fold check) are timed too
+  std::unique_ptr<RankSlabs<GridT>> ranks_;  ///< under mpirun (more than one rank), else null
+  mutable KernelTimers timers_;              ///< const kernels (residual, fold check) are timed too
 };
 
 /// "total energy grew by ..." for the energy guard.
@@ -262,21 +279,55 @@ SolverCore<GridT>::SolverCore(const Scene& scene, GridT grid, ColumnStore& parti
   rigid_force_.assign(scene_.bodies.size(), Vec3::Zero());
   scratch_.resize(omp_get_max_threads());
   for (auto& s : scratch_) s = std::make_unique<StressScratch>();
+  if constexpr (kRanks)
+    if (Comm::world().parallel()) ranks_ = std::make_unique<RankSlabs<GridT>>(Comm::world());
   const ParticleView<D> p = view<D>(particles_);
   material_ = p.material;
-  node_mass_floor_ = check_start_and_mass_floor(grid_, p);
+  node_mass_floor_ = check_start_and_mass_floor(grid_, p, ranks_ ? &Comm::world() : nullptr);
 }
 
 template <Grid GridT>
 void SolverCore<GridT>::sort_particles() {
   ScopedTimer timer(timers_, timers_.id("sort"));
-  removed_count_ += account_exits<D>(particles_, exits_, balance_);
-  escapes_.add(particles_, exits_, time_);
-  binning_.sort(particles_, grid_, exits_);
+  if (!ranks_) {
+    removed_count_ += account_exits<D>(particles_, exits_, balance_);
+    escapes_.add(particles_, exits_, time_);
+    binning_.sort(particles_, grid_, exits_);
+  } else if constexpr (kRanks) {
+    // Under mpirun: the exits dropped and booked on every rank, the slabs cut again and the
+    // particles sent to their ranks, the window fitted, the shared nodes found.
+    Balance d;
+    const std::size_t count = account_exits<D>(particles_, exits_, d);
+    escapes_.add(particles_, exits_, time_);
+    reduce_removed(d, count);
+    binning_.sort(particles_, grid_, ranks_->migrate(particles_, grid_, exits_));
+    ranks_->share_nodes(grid_);
+  }
   exits_.clear();
   need_sort_ = false;
   ++sorts_;
   material_ = view<D>(particles_).material;
+}
+
+template <Grid GridT>
+void SolverCore<GridT>::reduce_removed(const Balance& d, std::size_t count) {
+  double v[11] = {d.removed,
+                  d.kinetic,
+                  d.internal,
+                  d.removed_mass,
+                  d.momentum[0],
+                  d.momentum[1],
+                  d.momentum[2],
+                  d.removed_momentum[0],
+                  d.removed_momentum[1],
+                  d.removed_momentum[2],
+                  double(count)};
+  Comm::world().sum(v, 11);
+  balance_.removed += v[0], balance_.kinetic += v[1], balance_.internal += v[2];
+  balance_.removed_mass += v[3];
+  for (int a = 0; a < 3; ++a)
+    balance_.momentum[a] += v[4 + a], balance_.removed_momentum[a] += v[7 + a];
+  removed_count_ += std::size_t(v[10]);
 }
 
 template <Grid GridT>
@@ -320,7 +371,15 @@ void SolverCore<GridT>::restore_state(const StateValues& s) {
 
 template <Grid GridT>
 double SolverCore<GridT>::start_energies() {
-  const double speed = start_balance<D>(view<D>(particles_), materials_, balance_);
+  double speed = start_balance<D>(view<D>(particles_), materials_, balance_);
+  if (ranks_) {  // every rank's particles, summed in rank order
+    double v[5] = {balance_.kinetic, balance_.internal, balance_.momentum[0], balance_.momentum[1],
+                   balance_.momentum[2]};
+    Comm::world().sum(v, 5);
+    balance_.kinetic = v[0], balance_.internal = v[1];
+    for (int a = 0; a < 3; ++a) balance_.momentum[a] = v[2 + a];
+    speed = Comm::world().max(speed);
+  }
   total0_ = balance_.leapfrog_total = balance_.total();
   energy_scale_ = std::max(std::abs(total0_), balance_.kinetic);
   return stable_time_step(scene_.solver.dt_max, scene_.solver.cfl, grid_.min_cell_size(), speed);
@@ -330,7 +389,7 @@ template <Grid GridT>
 void SolverCore<GridT>::end_step(double dt, const char* remedy) {
   time_ += dt;
   ++steps_;
-  particle_steps_ += double(particles_.size());
+  particle_steps_ += double(particle_count());
   // The energy guard.
   energy_scale_ = std::max({energy_scale_, balance_.kinetic, std::abs(balance_.external_work)});
   const double growth = balance_.leapfrog_total - total0_;

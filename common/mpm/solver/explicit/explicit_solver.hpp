@@ -166,6 +166,10 @@ class ExplicitSolver : public SolverCore<GridT> {
     return at;
   }
   void fold_ghosts(int fields);
+  void sum_shared(int fields);
+  /// Under mpirun: every rank's sums added (rank order), and a fault on any rank thrown on all.
+  void reduce_ranks(ChunkSums& total, const InstabilityError* fault);
+  [[noreturn]] void throw_rank_fault(const InstabilityError* fault);
   /// v = p / m at the nodes with mass, zero elsewhere, for one field's arrays.
   void momentum_to_velocity(const double* m, Vec<D>* field);
   /// One field's grid update: v_i = (p_i or v_i) + dt f_i / m_i, a_i = f_i / m_i.
@@ -229,7 +233,7 @@ class ExplicitSolver : public SolverCore<GridT> {
       Core::materials_, Core::need_sort_, Core::node_mass_floor_, Core::particles_,
       Core::plane_stress_, Core::rigid_force_, Core::rigid_held_, Core::rigid_mark_,
       Core::marked_body_, Core::rigid_velocity_, Core::scene_, Core::scratch_, Core::steps_,
-      Core::time_, Core::timers_;
+      Core::time_, Core::timers_, Core::ranks_;
   using Core::book_rigid_force, Core::reduce, Core::rigid, Core::sort_particles, Core::track_move,
       Core::update_block;
 

@@ -10,6 +10,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+#include <string>
 
 #include "mpm/solver/explicit/contact.hpp"
 #include "mpm/solver/explicit/explicit_solver.hpp"
@@ -149,7 +153,17 @@ std::size_t ExplicitSolver<GridT>::work_bytes() const {
 template <Grid GridT>
 void ExplicitSolver<GridT>::finish(std::vector<ChunkSums>& stats, int changed) {
   ChunkSums total;
-  reduce(stats, total);
+  if (!ranks_) {
+    reduce(stats, total);
+  } else {
+    std::unique_ptr<InstabilityError> fault;
+    try {
+      reduce(stats, total);
+    } catch (const InstabilityError& e) {
+      fault = std::make_unique<InstabilityError>(e);
+    }
+    reduce_ranks(total, fault.get());
+  }
   if (changed & kVelocities) {
     leapfrog_kinetic_ = total.leapfrog_kinetic;
     load_work_ = total.work;
@@ -166,11 +180,68 @@ void ExplicitSolver<GridT>::finish(std::vector<ChunkSums>& stats, int changed) {
   if (changed & kPositions) {
     balance_.kinetic = total.kinetic;
     balance_.momentum = total.momentum;
-    const double n = double(std::max<std::size_t>(1, particles_.size()));
-    if (total.out_of_window || !exits_.empty() || total.strays > 0.01 * n ||
-        total.off_bin > 0.1 * n)
+    const double n = double(std::max<std::size_t>(1, this->particle_count()));
+    if (total.out_of_window || !exits_.empty() || total.exits.size() > 0 ||
+        total.strays > 0.01 * n || total.off_bin > 0.1 * n)
       need_sort_ = true;
   }
+}
+
+template <Grid GridT>
+void ExplicitSolver<GridT>::reduce_ranks(ChunkSums& t, const InstabilityError* fault) {
+  const Comm& comm = Comm::world();
+  double v[13] = {t.internal,
+                  t.kinetic,
+                  t.leapfrog_kinetic,
+                  t.work,
+                  t.work_start,
+                  t.momentum[0],
+                  t.momentum[1],
+                  t.momentum[2],
+                  double(t.off_bin),
+                  double(t.strays),
+                  t.out_of_window ? 1.0 : 0.0,
+                  double(exits_.size()),
+                  fault ? 1.0 : 0.0};
+  comm.sum(v, 13);
+  if (v[12] > 0) throw_rank_fault(fault);
+  t.internal = v[0], t.kinetic = v[1], t.leapfrog_kinetic = v[2], t.work = v[3];
+  t.work_start = v[4];
+  for (int a = 0; a < 3; ++a) t.momentum[a] = v[5 + a];
+  t.off_bin = long(v[8]), t.strays = long(v[9]), t.out_of_window = v[10] > 0;
+  t.exits.assign(std::size_t(v[11]), 0);  // how many left the domain on any rank
+  t.dt_min = comm.min(t.dt_min);
+}
+
+/// A fault on some rank: every rank throws the lowest faulty rank's InstabilityError.
+template <Grid GridT>
+void ExplicitSolver<GridT>::throw_rank_fault(const InstabilityError* fault) {
+  auto exact = [](double x) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.17g", x);
+    return std::string(b);
+  };
+  std::string mine;
+  if (fault)
+    mine = std::to_string(fault->step) + '\n' + exact(fault->time) + '\n' +
+           std::to_string(fault->particle) + '\n' + (fault->left_domain ? "1" : "0") + '\n' +
+           fault->cause;
+  for (const std::string& f : Comm::world().all_gather(mine)) {
+    if (f.empty()) continue;
+    std::size_t at = 0;
+    auto field = [&] {
+      const std::size_t end = f.find('\n', at);
+      std::string s = f.substr(at, end - at);
+      at = end + 1;
+      return s;
+    };
+    const long step = std::stol(field());
+    const double time = std::stod(field());
+    const long particle = std::stol(field());
+    const bool left = field() == "1";
+    throw InstabilityError(step, time, particle, f.substr(at), left);
+  }
+  throw std::logic_error("a rank reported a fault without its message");
 }
 
 }  // namespace mpm

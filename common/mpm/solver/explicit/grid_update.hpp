@@ -27,6 +27,7 @@ void ExplicitSolver<GridT>::grid_update(NodeV in_v) {
   }
   exchange_momentum(Exchange::Update);
   apply_boundary(Exchange::Update);
+  if (ranks_) Comm::world().sum(face_force_.data(), 6);  // each node counted by its owner
 }
 
 template <Grid GridT>
@@ -52,6 +53,7 @@ void ExplicitSolver<GridT>::integrate_nodes(const double* m_i, Vec<D>* v, Vec<D>
 template <Grid GridT>
 void ExplicitSolver<GridT>::grid_remap() {
   ScopedTimer timer(timers_, timers_.id("grid_remap"));
+  sum_shared(kRemap);
   fold_ghosts(kRemap);
   momentum_to_velocity(grid_.m.data(), grid_.v_remap.data());
   for (int f = 1; f < contact_.field_count(); ++f)
@@ -100,6 +102,8 @@ void ExplicitSolver<GridT>::hold_nodes(const double* m, Vec<D>* vel, Vec<D>* acc
   // Record the force each face carries (before holding the velocities), then hold them.
   if (record_force) {
     auto record = [&](std::int64_t n, int face) {
+      if constexpr (Core::kRanks)
+        if (ranks_ && !ranks_->owns(n)) return;  // another rank counts it
       const int axis = face / 2;
       const double sign = (face % 2 == 0) ? -1.0 : 1.0;
       face_force_[face] += sign * m[n] * vel[n][axis] / dt_;

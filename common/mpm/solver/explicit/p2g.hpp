@@ -20,7 +20,19 @@ void ExplicitSolver<GridT>::p2g() {
     scatter_to_grid<F, true>();
   else
     scatter_to_grid<F, false>();
+  sum_shared(F);
   fold_ghosts(F);
+}
+
+/// Under mpirun: the nodes this rank's window shares with its neighbours' summed across them
+/// (RankSlabs::sum_shared), so that every rank holds the whole grid its particles see.
+template <Grid GridT>
+void ExplicitSolver<GridT>::sum_shared([[maybe_unused]] int fields) {
+  if constexpr (Core::kRanks)
+    if (ranks_) {
+      ScopedTimer timer(timers_, timers_.id("ranks_nodes"));
+      ranks_->sum_shared(grid_, fields);
+    }
 }
 
 /// B-spline grids: the ghost nodes' mass, momentum, force or remapped momentum (the `fields`
