@@ -42,18 +42,23 @@ def history(post, stream):
     return names, rows
 
 
+def group(name):
+    """A vector's components share a scale: force_platen_y -> force_platen."""
+    return name[:-2] if len(name) > 2 and name[-2] == "_" and name[-1] in "xyz" else name
+
+
 def history_difference(a, b):
     names, ra = a
     _, rb = b
     if len(ra) != len(rb):
         return float("inf"), "rows"
-    mom = [k for k, n in enumerate(names) if "momentum_" in n]
-    mscale = max([abs(r[k]) for r in ra for k in mom] or [0])
+    scale = {}
+    for k, n in enumerate(names):
+        scale[group(n)] = max(scale.get(group(n), 0.0), max(abs(r[k]) for r in ra))
     worst, which = 0.0, ""
     for k, n in enumerate(names):
-        scale = mscale if k in mom else max(abs(r[k]) for r in ra)
         d = max(abs(x[k] - y[k]) for x, y in zip(ra, rb))
-        rel = d / scale if scale > 0 else d
+        rel = d / scale[group(n)] if scale[group(n)] > 0 else d
         if rel > worst:
             worst, which = rel, n
     return worst, which

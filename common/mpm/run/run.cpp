@@ -575,8 +575,6 @@ void refuse_under_ranks(const Scene& scene, bool rebar) {
   if (scene.grid.shape != GridShape::Linear) refuse("grid.shape", "a B-spline grid");
   if (!scene.contacts.empty()) refuse("contact", "a scene with [[contact]]");
   if (rebar || !scene.rebars.empty()) refuse("rebar", "a scene with [[rebar]]");
-  for (const auto& b : scene.bodies)
-    if (b.rigid) refuse("bodies." + b.name + ".rigid", "a scene with rigid bodies");
 }
 
 template <int D>

@@ -226,6 +226,26 @@ class RankSlabs {
     }
   }
 
+  /// The largest of the holders' marks at every shared node (the rigid bodies' marks, which a
+  /// rank sets only from its own rigid particles; where two bodies mark one node across a cut
+  /// the higher mark wins, as the later one does in one process).
+  void max_shared(std::vector<std::uint8_t>& marks) {
+    if (partners_.empty()) return;
+    send_.resize(partners_.size()), recv_.resize(partners_.size());
+    for (std::size_t k = 0; k < partners_.size(); ++k) {
+      send_[k].resize(shared_[k].size());
+      recv_[k].resize(shared_[k].size());
+      for (std::size_t j = 0; j < shared_[k].size(); ++j)
+        send_[k][j] = marks[std::size_t(shared_[k][j])];
+    }
+    comm_.exchange(partners_, send_, recv_);
+    for (std::size_t k = 0; k < partners_.size(); ++k)
+      for (std::size_t j = 0; j < shared_[k].size(); ++j) {
+        std::uint8_t& m = marks[std::size_t(shared_[k][j])];
+        m = std::max(m, std::uint8_t(recv_[k][j]));
+      }
+  }
+
   /// Whether this rank counts node `node` in node sums (it is the lowest rank holding it).
   bool owns(std::int64_t node) const { return owned_.empty() || owned_[std::size_t(node)] != 0; }
   /// All ranks' particles after the last migration.

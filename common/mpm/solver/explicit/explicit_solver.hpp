@@ -167,6 +167,7 @@ class ExplicitSolver : public SolverCore<GridT> {
   }
   void fold_ghosts(int fields);
   void sum_shared(int fields);
+  void reduce_support_forces(double work_before);
   /// Under mpirun: every rank's sums added (rank order), and a fault on any rank thrown on all.
   void reduce_ranks(ChunkSums& total, const InstabilityError* fault);
   [[noreturn]] void throw_rank_fault(const InstabilityError* fault);

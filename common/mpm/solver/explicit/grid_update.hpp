@@ -20,6 +20,7 @@ void ExplicitSolver<GridT>::grid_velocity() {
 template <Grid GridT>
 void ExplicitSolver<GridT>::grid_update(NodeV in_v) {
   ScopedTimer timer(timers_, timers_.id("grid_update"));
+  const double work_before = balance_.external_work;
   integrate_nodes(grid_.m.data(), grid_.v.data(), grid_.a.data(), in_v);
   for (int f = 1; f < contact_.field_count(); ++f) {
     auto& fd = contact_.field(f);
@@ -27,7 +28,23 @@ void ExplicitSolver<GridT>::grid_update(NodeV in_v) {
   }
   exchange_momentum(Exchange::Update);
   apply_boundary(Exchange::Update);
-  if (ranks_) Comm::world().sum(face_force_.data(), 6);  // each node counted by its owner
+  if (ranks_) reduce_support_forces(work_before);
+}
+
+/// Under mpirun: the forces on the faces and rigid bodies (each node counted by its owner) and
+/// the rigid bodies' work in the step, added over the ranks in rank order.
+template <Grid GridT>
+void ExplicitSolver<GridT>::reduce_support_forces(double work_before) {
+  std::vector<double> v(face_force_.begin(), face_force_.end());
+  v.push_back(balance_.external_work - work_before);
+  if (has_rigid_)
+    for (const Vec3& f : rigid_force_) v.insert(v.end(), {f[0], f[1], f[2]});
+  Comm::world().sum(v.data(), int(v.size()));
+  std::copy(v.begin(), v.begin() + 6, face_force_.begin());
+  balance_.external_work = work_before + v[6];
+  if (has_rigid_)
+    for (std::size_t b = 0; b < rigid_force_.size(); ++b)
+      for (int a = 0; a < 3; ++a) rigid_force_[b][a] = v[7 + 3 * b + std::size_t(a)];
 }
 
 template <Grid GridT>
@@ -134,9 +151,12 @@ void ExplicitSolver<GridT>::hold_nodes(const double* m, Vec<D>* vel, Vec<D>* acc
     const std::uint32_t body = marked_body_[mark - 1];
     const Vec<D>& vb = rigid_velocity_[body];
     const std::uint8_t held = rigid_held_[body];  // the other components slip
+    bool book = record_force;
+    if constexpr (Core::kRanks)
+      if (ranks_ && !ranks_->owns(i)) book = false;  // another rank counts it
     for (int a = 0; a < D; ++a) {
       if (!(held >> a & 1)) continue;
-      if (record_force)  // what the body pushes back; its work on the material
+      if (book)  // what the body pushes back; its work on the material
         book_rigid_force(int(body), a, m[i] * (vel[i][a] - vb[a]) / dt_);
       if (acc) acc[i][a] += (vb[a] - vel[i][a]) / dt_;
       vel[i][a] = vb[a];

@@ -13,7 +13,11 @@ void ExplicitSolver<GridT>::p2g() {
                                                        : "p2g_mass_momentum"));
   if constexpr (F & kMass) {
     grid_.clear(scheme_ == Scheme::MUSL, has_rigid_);
-    if (has_rigid_) mark_rigid_nodes();
+    if (has_rigid_) {
+      mark_rigid_nodes();
+      if constexpr (Core::kRanks)
+        if (ranks_) ranks_->max_shared(grid_.rigid);  // bodies on other ranks touch them too
+    }
     if (contact_.active()) contact_.clear(grid_.nodes(), scheme_ == Scheme::MUSL);
   }
   if (contact_.active())
