@@ -81,20 +81,20 @@ void Comm::sum(double* v, int n) const {
   }
 }
 
-double Comm::min(double v) const {
-  if (size_ == 1) return v;
+/// One double reduced over the ranks by `op` (min or max: exact in any order).
+static double reduce_one(double v, MPI_Op op, double& bytes, double& messages) {
   double out = v;
-  check(MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD), "MPI_Allreduce");
-  bytes_ += 8, messages_ += 1;
+  check(MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, op, MPI_COMM_WORLD), "MPI_Allreduce");
+  bytes += 8, messages += 1;
   return out;
 }
 
+double Comm::min(double v) const {
+  return size_ == 1 ? v : reduce_one(v, MPI_MIN, bytes_, messages_);
+}
+
 double Comm::max(double v) const {
-  if (size_ == 1) return v;
-  double out = v;
-  check(MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
-  bytes_ += 8, messages_ += 1;
-  return out;
+  return size_ == 1 ? v : reduce_one(v, MPI_MAX, bytes_, messages_);
 }
 
 std::vector<std::string> Comm::all_gather(const std::string& mine) const {

@@ -60,20 +60,14 @@ std::string pack_schema(const ColumnStore& cols) {
 }
 
 void add_schema(ColumnStore& cols, const std::string& schema) {
-  std::size_t at = 0;
-  auto line = [&] {
-    const std::size_t end = schema.find('\n', at);
-    std::string l = schema.substr(at, end - at);
-    at = end + 1;
-    return l;
-  };
-  while (at < schema.size()) {
+  Fields f(schema);
+  while (!f.done()) {
     ColumnInfo i;
-    i.name = line();
-    const std::string tc = line();
+    i.name = f.next();
+    const std::string tc = f.next();
     i.type = ScalarType(std::stoi(tc));
     i.components = std::stoi(tc.substr(tc.find(' ') + 1));
-    i.unit = line();
+    i.unit = f.next();
     cols.add(i);
   }
 }

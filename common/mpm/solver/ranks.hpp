@@ -22,6 +22,25 @@
 
 namespace mpm {
 
+/// Newline-separated fields of a text, read one after the other (messages between ranks).
+class Fields {
+ public:
+  explicit Fields(const std::string& text) : text_(text) {}
+  bool done() const { return at_ >= text_.size(); }
+  std::string next() {
+    const std::size_t end = text_.find('\n', at_);
+    std::string s = text_.substr(at_, end - at_);
+    at_ = end == std::string::npos ? text_.size() : end + 1;
+    return s;
+  }
+  /// What is left, newlines and all.
+  std::string rest() const { return done() ? std::string() : text_.substr(at_); }
+
+ private:
+  const std::string& text_;
+  std::size_t at_ = 0;
+};
+
 /// Rows `rows` of every column of a store, column after column (the receiver has the same
 /// columns in the same order).
 std::string pack_rows(const ColumnStore& cols, const std::vector<std::uint32_t>& rows);

@@ -226,20 +226,14 @@ void ExplicitSolver<GridT>::throw_rank_fault(const InstabilityError* fault) {
     mine = std::to_string(fault->step) + '\n' + exact(fault->time) + '\n' +
            std::to_string(fault->particle) + '\n' + (fault->left_domain ? "1" : "0") + '\n' +
            fault->cause;
-  for (const std::string& f : Comm::world().all_gather(mine)) {
-    if (f.empty()) continue;
-    std::size_t at = 0;
-    auto field = [&] {
-      const std::size_t end = f.find('\n', at);
-      std::string s = f.substr(at, end - at);
-      at = end + 1;
-      return s;
-    };
-    const long step = std::stol(field());
-    const double time = std::stod(field());
-    const long particle = std::stol(field());
-    const bool left = field() == "1";
-    throw InstabilityError(step, time, particle, f.substr(at), left);
+  for (const std::string& text : Comm::world().all_gather(mine)) {
+    if (text.empty()) continue;
+    Fields f(text);
+    const long step = std::stol(f.next());
+    const double time = std::stod(f.next());
+    const long particle = std::stol(f.next());
+    const bool left = f.next() == "1";
+    throw InstabilityError(step, time, particle, f.rest(), left);
   }
   throw std::logic_error("a rank reported a fault without its message");
 }
