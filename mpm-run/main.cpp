@@ -77,7 +77,9 @@ int main(int argc, char** argv) {
         throw mpm::InputError("--restart", "continues a result stream; give no model stream");
       if (!app.count("--output")) opt.output = opt.restart;  // append to it
     }
-    mpm::refuse_terminal_output(opt.output, "the result stream");
+    // Under mpirun a rank's standard output is mpirun's pseudo-terminal, whatever mpirun's own
+    // is: the check would refuse every pipe.
+    if (!comm.parallel()) mpm::refuse_terminal_output(opt.output, "the result stream");
     mpm::check_output_file(opt.output, {opt.input});
     if (!max_memory.empty()) opt.max_memory = mpm::parse_memory_size(max_memory, "--max-memory");
     return mpm::run_model(opt);

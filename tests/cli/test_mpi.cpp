@@ -186,6 +186,13 @@ TEST(Mpi, TaylorBarTwoRanksMatchOneProcess) {
     const double x = json_value(a.out, key), y = json_value(b.out, key);
     EXPECT_LE(std::abs(x - y), kTolerance * std::abs(x)) << key << ": " << x << " against " << y;
   }
+  // The pipeline: the model on mpirun's standard input, the stream on its standard output (a
+  // rank's is mpirun's pseudo-terminal): the same bytes as the run that wrote a file.
+  const Result p = run(prep + " " + kExamples + "taylor-bar/scene.toml | " + mpirun2() + runner +
+                           " --threads 1 --progress none | cat > " + (dir / "pipe.mpm").string(),
+                       dir);
+  EXPECT_EQ(p.status, 0) << p.err;
+  EXPECT_EQ(slurp(dir / "pipe.mpm"), slurp(dir / "two0.mpm")) << "mpirun in a pipe";
 }
 
 // The sparse grid (its shared nodes are the active ones both ranks have).
