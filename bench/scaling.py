@@ -21,10 +21,10 @@ import argparse
 import math
 
 # Measured on this machine (2026-11-26; commands in docs/performance.md).
-T_P_NS = 116.0  # ns per particle-step, one thread: V3 model 3 (bench/ranks.py, 1 x 1: 8.6 M/s)
+T_P_NS = 107.5  # ns per particle-step, one thread: V3 model 3 (bench/ranks.py, 1 x 1: 9.30 M/s)
 B_NODE = 80.0  # bytes per shared node and step: MUSL sends 7 doubles after p2g, 3 after remap
-C_COLLECTIVES = 6  # rank-ordered sums and minima a step (mpm-run --stats: ~10 messages/step at
-W_SUM = 13  # 2 ranks, 4 of them the two node exchanges); doubles in the largest sum
+C_COLLECTIVES = 7  # sums, minima and flags a step (two kernels x sum and min, face forces,
+W_SUM = 13  # signal, checkpoint; --stats: 10.2 messages a step); doubles in the largest
 E_PARTICLE = 134.0  # bytes a particle carries when it crosses a cut (its columns)
 MIGRATION = 2e-5  # particles crossing a cut per step, per particle of the rank (Taylor, V3: ~2e-5)
 # Shared nodes per cut: V4 coarse deck (2.12 mm cells) measured 17 840 under 2 ranks, slabs
