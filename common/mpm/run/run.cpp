@@ -286,8 +286,8 @@ class TimeLoop {
     }
   }
   /// The particles as a frame, or in a checkpoint, written without copying them; under
-  /// mpirun every rank's, gathered at the root in particle-id order (then `gathered` holds
-  /// them until the next frame).
+  /// mpirun every rank's, gathered at the root in particle-id order into gathered_ (which
+  /// emit_frame samples for the material extremes, then frees).
   template <class Write>
   void write_particles(std::uint32_t flags, Write&& write) {
     Frame f;
