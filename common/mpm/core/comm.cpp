@@ -48,6 +48,15 @@ int count_of(std::size_t n) {
   return int(n);
 }
 
+/// displs[r] = the bytes before rank r's (counts in rank order); returns the total.
+std::size_t displacements(const std::vector<int>& counts, std::vector<int>& displs) {
+  std::size_t total = 0;
+  displs.resize(counts.size());
+  for (std::size_t r = 0; r < counts.size(); ++r)
+    displs[r] = count_of(total), total += std::size_t(counts[r]);
+  return total;
+}
+
 }  // namespace
 
 CommSession::CommSession(int& argc, char**& argv) {
@@ -100,11 +109,9 @@ double Comm::max(double v) const {
 std::vector<std::string> Comm::all_gather(const std::string& mine) const {
   if (size_ == 1) return {mine};
   int n = count_of(mine.size());
-  std::vector<int> counts(static_cast<std::size_t>(size_)), displs(static_cast<std::size_t>(size_));
+  std::vector<int> counts(static_cast<std::size_t>(size_)), displs;
   check(MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD), "MPI_Allgather");
-  std::size_t total = 0;
-  for (int r = 0; r < size_; ++r) displs[std::size_t(r)] = count_of(total), total += counts[r];
-  std::string all(total, '\0');
+  std::string all(displacements(counts, displs), '\0');
   check(MPI_Allgatherv(mine.data(), n, MPI_BYTE, all.data(), counts.data(), displs.data(), MPI_BYTE,
                        MPI_COMM_WORLD),
         "MPI_Allgatherv");
@@ -122,11 +129,9 @@ std::string Comm::gather(const std::string& mine, std::vector<std::size_t>& offs
     return mine;
   }
   int n = count_of(mine.size());
-  std::vector<int> counts(static_cast<std::size_t>(size_)), displs(static_cast<std::size_t>(size_));
+  std::vector<int> counts(static_cast<std::size_t>(size_)), displs;
   check(MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD), "MPI_Gather");
-  std::size_t total = 0;
-  if (root())
-    for (int r = 0; r < size_; ++r) displs[std::size_t(r)] = count_of(total), total += counts[r];
+  const std::size_t total = displacements(counts, displs);  // zeros but at the root
   std::string all(total, '\0');
   check(MPI_Gatherv(mine.data(), n, MPI_BYTE, all.data(), counts.data(), displs.data(), MPI_BYTE, 0,
                     MPI_COMM_WORLD),
@@ -156,19 +161,17 @@ void Comm::broadcast(std::string& bytes) const {
 std::vector<std::string> Comm::all_to_all(std::vector<std::string> send) const {
   if (size_ == 1) return send;
   std::vector<int> scount(static_cast<std::size_t>(size_)), rcount(static_cast<std::size_t>(size_));
-  std::vector<int> sdispl(static_cast<std::size_t>(size_)), rdispl(static_cast<std::size_t>(size_));
+  std::vector<int> sdispl, rdispl;
   std::string out_bytes;
   for (int r = 0; r < size_; ++r) {
-    sdispl[std::size_t(r)] = count_of(out_bytes.size());
     scount[std::size_t(r)] = count_of(send[std::size_t(r)].size());
     out_bytes += send[std::size_t(r)];
     if (r != rank_) bytes_ += double(scount[std::size_t(r)]), messages_ += 1;
   }
+  displacements(scount, sdispl);
   check(MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, MPI_COMM_WORLD),
         "MPI_Alltoall");
-  std::size_t total = 0;
-  for (int r = 0; r < size_; ++r) rdispl[std::size_t(r)] = count_of(total), total += rcount[r];
-  std::string in_bytes(total, '\0');
+  std::string in_bytes(displacements(rcount, rdispl), '\0');
   check(MPI_Alltoallv(out_bytes.data(), scount.data(), sdispl.data(), MPI_BYTE, in_bytes.data(),
                       rcount.data(), rdispl.data(), MPI_BYTE, MPI_COMM_WORLD),
         "MPI_Alltoallv");

@@ -561,26 +561,30 @@ int run_solver(const RunOptions& opt, const Scene& scene, const Lattice& lattice
   return loop();
 }
 
+/// What a refusal under mpirun adds: what the decomposition covers.
+std::string under_ranks() {
+  return "under mpirun (" + std::to_string(Comm::world().size()) +
+         " ranks) mpm-run decomposes the explicit solver on a uniform or sparse grid with linear "
+         "shape functions: run this scene without mpirun";
+}
+
 /// Under mpirun: what the domain decomposition does not cover yet, refused before the run.
-void refuse_under_ranks(const Scene& scene, bool rebar) {
+void refuse_under_ranks(const Scene& scene) {
   if (!Comm::world().parallel()) return;
-  const std::string ranks = "under mpirun (" + std::to_string(Comm::world().size()) + " ranks)";
   auto refuse = [&](const std::string& key, const std::string& what) {
-    throw InputError(key, what + " runs on one process; " + ranks +
-                              " mpm-run decomposes the explicit solver on a uniform or sparse "
-                              "grid with linear shape functions: run this scene without mpirun");
+    throw InputError(key, what + " runs on one process; " + under_ranks());
   };
   if (scene.solver.type == SolverType::Implicit) refuse("solver.type", "the implicit solver");
   if (!scene.grid.levels.empty()) refuse("grid.levels", "a graded grid");
   if (scene.grid.shape != GridShape::Linear) refuse("grid.shape", "a B-spline grid");
   if (!scene.contacts.empty()) refuse("contact", "a scene with [[contact]]");
-  if (rebar || !scene.rebars.empty()) refuse("rebar", "a scene with [[rebar]]");
+  if (!scene.rebars.empty()) refuse("rebar", "a scene with [[rebar]]");
 }
 
 template <int D>
 int run(const RunOptions& opt, const Scene& scene, const Lattice& lattice, Frame& model,
         const Restart* restart, ColumnStore* rebar = nullptr) {
-  refuse_under_ranks(scene, rebar != nullptr);
+  refuse_under_ranks(scene);
   const bool graded = !scene.grid.levels.empty();  // mesh grading (004, section 3)
   if (scene.solver.type == SolverType::Implicit) {
     if (graded)
@@ -671,6 +675,9 @@ Model read_model_on_ranks(const RunOptions& opt) {
   if (comm.root()) {
     try {
       model = read_model(opt);
+      if (!model.rebar.columns.columns().empty())  // only the root would know
+        throw InputError(
+            "rebar", "a model with rebar elements (REBR) runs on one process; " + under_ranks());
     } catch (const InputError& e) {
       error = e.what();
     }
@@ -678,14 +685,11 @@ Model read_model_on_ranks(const RunOptions& opt) {
   comm.broadcast(error);
   if (!error.empty()) throw InputError("", error);
   std::string scene = model.scene_text, schema = pack_schema(model.frame.columns);
-  std::string rebar = model.rebar.columns.columns().empty() ? "" : "rebar";
   comm.broadcast(scene);
   comm.broadcast(schema);
-  comm.broadcast(rebar);
   if (!comm.root()) {
     model.scene_text = scene;
     add_schema(model.frame.columns, schema);
-    if (!rebar.empty()) model.rebar.columns.add({"rebar", ScalarType::U8, 1, "-"});
   }
   return model;
 }

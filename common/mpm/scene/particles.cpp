@@ -39,6 +39,7 @@ void ensure(ColumnStore& cols, const ColumnInfo& info) {
 
 BodyIds::BodyIds(const Column* c) {
   if (!c) return;
+  present_ = true;
   if (c->info().components == 1 && c->info().type == ScalarType::U8)
     u8_ = c->as<std::uint8_t>();
   else if (c->info().components == 1 && c->info().type == ScalarType::U32)
@@ -63,7 +64,7 @@ void prepare_columns(ColumnStore& cols, const Scene& scene) {
   require(cols, col::material, ScalarType::U8, 1);
   const auto* mat = cols.get<std::uint8_t>(col::material);
   const BodyIds body(cols.find(col::body));
-  if (!cols.find(col::body)) throw InputError("model", "particle column 'body' is missing");
+  if (!body) throw InputError("model", "particle column 'body' is missing");
   for (std::size_t i = 0; i < cols.size(); ++i) {
     if (std::size_t(body[i]) >= scene.bodies.size())
       throw InputError("model", "particle " + std::to_string(i) + " refers to body " +

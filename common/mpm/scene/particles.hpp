@@ -54,9 +54,11 @@ class BodyIds {
   explicit BodyIds(const Column* c);
   /// The body of element i.
   int operator[](std::size_t i) const { return u8_ ? int(u8_[i]) : int(u32_[i]); }
-  explicit operator bool() const { return u8_ || u32_; }
+  /// True when there is a column (even one of no rows).
+  explicit operator bool() const { return present_; }
 
  private:
+  bool present_ = false;
   const std::uint8_t* u8_ = nullptr;
   const std::uint32_t* u32_ = nullptr;
 };

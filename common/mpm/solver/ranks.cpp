@@ -9,29 +9,21 @@
 
 namespace mpm {
 
-std::string pack_rows(const ColumnStore& cols, const std::vector<std::uint32_t>& rows) {
-  std::string out;
-  pack_rows(cols, rows, out);
-  return out;
-}
-
 void pack_rows(const ColumnStore& cols, const std::vector<std::uint32_t>& rows, std::string& out) {
-  std::size_t bytes = 0;
-  for (const Column& c : cols.columns()) bytes += rows.size() * c.info().element_bytes();
   const std::size_t start = out.size();
-  out.resize(start + bytes);
+  out.resize(start + rows.size() * cols.element_bytes());
   char* o = out.data() + start;
-  const bool all = rows.size() == cols.size() && (rows.empty() || rows.back() + 1 == rows.size());
   for (const Column& c : cols.columns()) {
     const std::size_t w = c.info().element_bytes();
     const auto* d = reinterpret_cast<const char*>(c.data());
-    if (all) {  // every row in order (a frame): the column at once
-      if (!rows.empty()) std::memcpy(o, d, rows.size() * w);
-      o += rows.size() * w;
-      continue;
-    }
     for (auto r : rows) std::memcpy(o, d + std::size_t(r) * w, w), o += w;
   }
+}
+
+void pack_columns(const ColumnStore& cols, std::string& out) {
+  out.reserve(out.size() + cols.bytes());
+  for (const Column& c : cols.columns())
+    if (c.bytes() > 0) out.append(reinterpret_cast<const char*>(c.data()), c.bytes());
 }
 
 void append_rows(ColumnStore& cols, const char* bytes, std::size_t size) {
@@ -75,32 +67,23 @@ void add_schema(ColumnStore& cols, const std::string& schema) {
 void gather_by_id(const Comm& comm, const ColumnStore& cols, ColumnStore& out) {
   // Each part: its schema's length (8 bytes), the schema, the rows (a rank whose store has no
   // columns yet, such as an empty escape log, sends none).
-  std::vector<std::uint32_t> all(cols.size());
-  std::iota(all.begin(), all.end(), 0u);
   const std::string schema = pack_schema(cols);
   const std::uint64_t len = schema.size();
   std::string mine(reinterpret_cast<const char*>(&len), sizeof len);
   mine += schema;
-  pack_rows(cols, all, mine);
+  pack_columns(cols, mine);
   std::vector<std::size_t> at;
   const std::string parts = comm.gather(mine, at);
   std::string().swap(mine);
   out = ColumnStore();
   if (!comm.root()) return;
-  std::size_t rows = 0;
-  const std::size_t w = cols.element_bytes();
-  for (std::size_t r = 0; r + 1 < at.size(); ++r) {
-    std::uint64_t l = 0;
-    std::memcpy(&l, parts.data() + at[r], sizeof l);
-    if (w > 0) rows += (at[r + 1] - at[r] - sizeof l - l) / w;
-  }
   for (std::size_t r = 0; r + 1 < at.size(); ++r) {
     std::uint64_t l = 0;
     std::memcpy(&l, parts.data() + at[r], sizeof l);
     if (l == 0) continue;
     if (out.columns().empty()) {
       add_schema(out, parts.substr(at[r] + sizeof l, l));
-      out.reserve(rows);
+      out.reserve((parts.size() - at[r]) / std::max<std::size_t>(1, out.element_bytes()));
     }
     append_rows(out, parts.data() + at[r] + sizeof l + l, at[r + 1] - at[r] - sizeof l - l);
   }

@@ -12,6 +12,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -42,15 +44,13 @@ class Fields {
 };
 
 /// Rows `rows` of every column of a store, column after column (the receiver has the same
-/// columns in the same order).
-std::string pack_rows(const ColumnStore& cols, const std::vector<std::uint32_t>& rows);
-/// The same, appended to `out`.
+/// columns in the same order), appended to `out`.
 void pack_rows(const ColumnStore& cols, const std::vector<std::uint32_t>& rows, std::string& out);
-/// Appends rows packed by pack_rows (`size` bytes at `bytes`) to a store with the same columns.
+/// Every row, the same way: each column's bytes as they are.
+void pack_columns(const ColumnStore& cols, std::string& out);
+/// Appends rows packed by pack_rows or pack_columns (`size` bytes at `bytes`) to a store with
+/// the same columns.
 void append_rows(ColumnStore& cols, const char* bytes, std::size_t size);
-inline void append_rows(ColumnStore& cols, const std::string& bytes) {
-  append_rows(cols, bytes.data(), bytes.size());
-}
 /// The columns' names, types, widths and units, for a rank that builds an empty store like it.
 std::string pack_schema(const ColumnStore& cols);
 /// Adds the columns pack_schema described to an empty store.
@@ -120,14 +120,15 @@ class RankSlabs {
     }
     std::vector<std::string> send(static_cast<std::size_t>(P));
     for (int q = 0; q < P; ++q)
-      if (q != comm_.rank()) send[std::size_t(q)] = pack_rows(particles, to[std::size_t(q)]);
+      if (q != comm_.rank()) pack_rows(particles, to[std::size_t(q)], send[std::size_t(q)]);
     std::vector<std::string> got = comm_.all_to_all(std::move(send));
     std::vector<std::uint32_t> drop;
     for (std::size_t i = 0; i < n; ++i)
       if (out[i]) drop.push_back(std::uint32_t(i));
     migrated_ += double(drop.size() - gone.size());
     for (int q = 0; q < P; ++q)
-      if (q != comm_.rank()) append_rows(particles, got[std::size_t(q)]);
+      if (q != comm_.rank())
+        append_rows(particles, got[std::size_t(q)].data(), got[std::size_t(q)].size());
     return drop;
   }
 
@@ -269,9 +270,8 @@ class RankSlabs {
   bool owns(std::int64_t node) const { return owned_.empty() || owned_[std::size_t(node)] != 0; }
   /// All ranks' particles after the last migration.
   std::size_t total_particles() const { return total_; }
-  /// The slab axis and the cuts: rank r holds the cells [cut(r), cut(r + 1)) along it.
+  /// The slab axis (rank r holds the cells [cut_[r], cut_[r + 1]) along it).
   int axis() const { return axis_; }
-  int cut(int r) const { return cut_[std::size_t(r)]; }
   /// Nodes this rank shares with others (after the last sort); particles it sent away so far.
   double shared_nodes() const { return shared_nodes_; }
   double migrated() const { return migrated_; }

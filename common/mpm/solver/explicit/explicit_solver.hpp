@@ -168,8 +168,9 @@ class ExplicitSolver : public SolverCore<GridT> {
   void fold_ghosts(int fields);
   void sum_shared(int fields);
   void reduce_support_forces(double work_before);
-  /// Under mpirun: every rank's sums added (rank order), and a fault on any rank thrown on all.
-  void reduce_ranks(ChunkSums& total, const InstabilityError* fault);
+  /// Under mpirun: every rank's sums added (rank order), and a fault on any rank thrown on all;
+  /// returns whether particles left the domain on any rank since the last sort.
+  bool reduce_ranks(ChunkSums& total, const InstabilityError* fault);
   [[noreturn]] void throw_rank_fault(const InstabilityError* fault);
   /// v = p / m at the nodes with mass, zero elsewhere, for one field's arrays.
   void momentum_to_velocity(const double* m, Vec<D>* field);

@@ -11,7 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -153,16 +153,18 @@ std::size_t ExplicitSolver<GridT>::work_bytes() const {
 template <Grid GridT>
 void ExplicitSolver<GridT>::finish(std::vector<ChunkSums>& stats, int changed) {
   ChunkSums total;
+  bool exits = false;  // particles left the domain since the last sort (on any rank)
   if (!ranks_) {
     reduce(stats, total);
+    exits = !exits_.empty();
   } else {
-    std::unique_ptr<InstabilityError> fault;
+    std::optional<InstabilityError> fault;
     try {
       reduce(stats, total);
     } catch (const InstabilityError& e) {
-      fault = std::make_unique<InstabilityError>(e);
+      fault.emplace(e);
     }
-    reduce_ranks(total, fault.get());
+    exits = reduce_ranks(total, fault ? &*fault : nullptr);
   }
   if (changed & kVelocities) {
     leapfrog_kinetic_ = total.leapfrog_kinetic;
@@ -181,14 +183,13 @@ void ExplicitSolver<GridT>::finish(std::vector<ChunkSums>& stats, int changed) {
     balance_.kinetic = total.kinetic;
     balance_.momentum = total.momentum;
     const double n = double(std::max<std::size_t>(1, this->particle_count()));
-    if (total.out_of_window || !exits_.empty() || total.exits.size() > 0 ||
-        total.strays > 0.01 * n || total.off_bin > 0.1 * n)
+    if (total.out_of_window || exits || total.strays > 0.01 * n || total.off_bin > 0.1 * n)
       need_sort_ = true;
   }
 }
 
 template <Grid GridT>
-void ExplicitSolver<GridT>::reduce_ranks(ChunkSums& t, const InstabilityError* fault) {
+bool ExplicitSolver<GridT>::reduce_ranks(ChunkSums& t, const InstabilityError* fault) {
   const Comm& comm = Comm::world();
   double v[13] = {t.internal,
                   t.kinetic,
@@ -209,8 +210,8 @@ void ExplicitSolver<GridT>::reduce_ranks(ChunkSums& t, const InstabilityError* f
   t.work_start = v[4];
   for (int a = 0; a < 3; ++a) t.momentum[a] = v[5 + a];
   t.off_bin = long(v[8]), t.strays = long(v[9]), t.out_of_window = v[10] > 0;
-  t.exits.assign(std::size_t(v[11]), 0);  // how many left the domain on any rank
   t.dt_min = comm.min(t.dt_min);
+  return v[11] > 0;
 }
 
 /// A fault on some rank: every rank throws the lowest faulty rank's InstabilityError.
