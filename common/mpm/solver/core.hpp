@@ -109,7 +109,8 @@ double check_start_and_mass_floor(const GridT& grid, const ParticleView<GridT::k
 
 /// Per-thread scratch of the constitutive update.
 struct StressScratch {
-  Mat3 L[kBlock];  ///< velocity gradients of the block, 1/s
+  Mat3 L[kBlock];                        ///< velocity gradients of the block, 1/s
+  alignas(64) double L_rows[9][kBlock];  ///< or one component an array (MaterialBlock::L_rows)
   double c[kBlock];
   BlockScratch S;
 };
@@ -214,10 +215,10 @@ class SolverCore {
   /// exits_ for the next sort).
   void reduce(const std::vector<ChunkSums>& chunks, ChunkSums& total);
   /// The material update of the pending block of the particles s (their own columns, or a
-  /// trial copy of the state), velocity gradients in scr.L; returns the block (signal speeds
-  /// in scr.c, faults).
-  MaterialBlock update_block(const PendingBlock& pb, const ParticleView<D>& s,
-                             StressScratch& scr) const;
+  /// trial copy of the state), velocity gradients in scr.L (with `rows` in scr.L_rows, one
+  /// component an array); returns the block (signal speeds in scr.c, faults).
+  MaterialBlock update_block(const PendingBlock& pb, const ParticleView<D>& s, StressScratch& scr,
+                             bool rows = false) const;
   /// Books the force F (N) the material exerts on rigid body `body` along `axis` in a step
   /// and the work the body does on the material.
   void book_rigid_force(int body, int axis, double F) {
@@ -450,12 +451,15 @@ void SolverCore<GridT>::reduce(const std::vector<ChunkSums>& chunks, ChunkSums& 
 
 template <Grid GridT>
 MaterialBlock SolverCore<GridT>::update_block(const PendingBlock& pb, const ParticleView<D>& s,
-                                              StressScratch& scr) const {
+                                              StressScratch& scr, bool rows) const {
   MaterialBlock blk;
   blk.n = pb.k;
   blk.dt = dt_;
   blk.h = pb.h;
-  blk.L = scr.L;
+  if (rows)
+    blk.L_rows = scr.L_rows;
+  else
+    blk.L = scr.L;
   blk.m = s.m + pb.i0;
   blk.set_state(s.sigma, s.rho, s.e, s.eps_p, s.T, s.failed, s.thickness, pb.i0);
   blk.set_history(s.damage, s.mu_max, pb.i0);

@@ -80,23 +80,24 @@ template <bool C>
                         v_r);
       }
       if (pb.ends_before(i, p.material[i], h_cell)) {
-        stress_block(p, pb, scr, s);
+        stress_block(p, pb, scr, s, move);
         pb.restart(i, p.material[i], h_cell);
       }
-      if constexpr (D == 3)
-        scr.L[pb.k] = L;
-      else
+      if constexpr (D == 3) {  // one component an array (MaterialBlock::L_rows)
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) scr.L_rows[3 * r + c][pb.k] = L(r, c);
+      } else {
         scr.L[pb.k].setZero(), scr.L[pb.k].template topLeftCorner<D, D>() = L;
+      }
       if (axi) scr.L[pb.k](2, 2) = v_r / p.x[i][0];  // hoop rate
       ++pb.k;
-      if (move) {
+      if (move) {             // (the block's kinetic energy and momentum: stress_block)
         p.x[i] += dt * vbar;  // (000, eq. 7)
-        s.add_motion(p, i);
         track_move(p.x[i], i, bin.key, s);
       }
     }
   }
-  stress_block(p, pb, scr, s);
+  stress_block(p, pb, scr, s, move);
 }
 
 /// The velocity gradient L = sum_i v_i (x) G_ip (000, eqs. 12-13 use its parts), the move
@@ -241,21 +242,37 @@ void ExplicitSolver<GridT>::move_unstressed(const ParticleView<D>& p, std::uint3
 }
 
 /// The material update of the pending block (then empty), its internal energy and stable
-/// steps into s, and the first fault.
+/// steps into s, and the first fault; with `motion` also its kinetic energy and momentum.
 template <Grid GridT>
 void ExplicitSolver<GridT>::stress_block(const ParticleView<D>& p, PendingBlock& pb,
-                                         StressScratch& scr, ChunkSums& s) const {
+                                         StressScratch& scr, ChunkSums& s, bool motion) const {
   if (pb.k == 0) return;
-  const MaterialBlock blk = update_block(pb, p, scr);
+  const MaterialBlock blk = update_block(pb, p, scr, D == 3);
   // In registers, not through s: the block's internal energy, and its fastest signal
-  // (min_j h / s_j is h / max_j s_j exactly: a division is monotone, one is enough).
-  double internal = 0, fastest = 0;
+  // (min_j h / s_j is h / max_j s_j exactly: a division is monotone, one is enough); partial
+  // sums and maxima a vector of particles at a time (in a fixed order: the same bits each run).
+  double internal = 0, fastest = 0, kinetic = 0;
+  const double* __restrict m = p.m + pb.i0, * __restrict e = p.e + pb.i0;
+  const double* __restrict v = p.v[pb.i0].data();
+  const double* __restrict c = scr.c;
+#pragma omp simd reduction(+ : internal, kinetic) reduction(max : fastest)
   for (int j = 0; j < pb.k; ++j) {
-    const std::uint32_t i = pb.i0 + j;
-    internal += p.m[i] * p.e[i];
-    fastest = std::max(fastest, scr.c[j] + p.v[i].norm());
+    internal += m[j] * e[j];
+    double v2 = 0;
+    for (int a = 0; a < D; ++a) v2 += v[D * j + a] * v[D * j + a];
+    fastest = std::max(fastest, c[j] + std::sqrt(v2));
+    kinetic += 0.5 * m[j] * v2;
   }
   s.internal += internal;
+  if (motion) {
+    s.kinetic += kinetic;
+    for (int a = 0; a < D; ++a) {
+      double q = 0;
+#pragma omp simd reduction(+ : q)
+      for (int j = 0; j < pb.k; ++j) q += m[j] * v[D * j + a];
+      s.momentum[a] += q;
+    }
+  }
   s.dt_min = std::min(s.dt_min, pb.h / fastest);
   if (blk.fault_index >= 0 && s.fault < 0) {
     s.fault = pb.i0 + blk.fault_index;

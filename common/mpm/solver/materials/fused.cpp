@@ -70,7 +70,8 @@ struct Columns {
 
 /// The update of the block: stresses in X, the rest in the block's columns.
 template <bool kPlastic, bool kMieGruneisen>
-void fused_block(const FusedModel& f, MaterialBlock& b, Columns& X) {
+void fused_block(const FusedModel& f, MaterialBlock& b, const double (*__restrict L)[kBlock],
+                 Columns& X) {
   const int n = b.n;
   const double dt = b.dt, hdt = 0.5 * dt, bh = b.h;
   const double G2 = 2.0 * f.G, G3 = 3.0 * f.G, G43 = 4.0 / 3.0 * f.G;
@@ -87,11 +88,11 @@ void fused_block(const FusedModel& f, MaterialBlock& b, Columns& X) {
 #pragma omp simd
   for (int i = 0; i < n; ++i) {
     // Kinematics (material.cpp, kinematics()).
-    const double dxx = dt * X.L[0][i], dyy = dt * X.L[4][i], dzz = dt * X.L[8][i];
-    const double dyz = hdt * (X.L[5][i] + X.L[7][i]), dxz = hdt * (X.L[2][i] + X.L[6][i]),
-                 dxy = hdt * (X.L[1][i] + X.L[3][i]);
-    const double wxy = hdt * (X.L[1][i] - X.L[3][i]), wxz = hdt * (X.L[2][i] - X.L[6][i]),
-                 wyz = hdt * (X.L[5][i] - X.L[7][i]);
+    const double dxx = dt * L[0][i], dyy = dt * L[4][i], dzz = dt * L[8][i];
+    const double dyz = hdt * (L[5][i] + L[7][i]), dxz = hdt * (L[2][i] + L[6][i]),
+                 dxy = hdt * (L[1][i] + L[3][i]);
+    const double wxy = hdt * (L[1][i] - L[3][i]), wxz = hdt * (L[2][i] - L[6][i]),
+                 wyz = hdt * (L[5][i] - L[7][i]);
     const double dvol = dxx + dyy + dzz;
     const double sxx = X.sig[0][i], syy = X.sig[1][i], szz = X.sig[2][i], syz = X.sig[3][i],
                  sxz = X.sig[4][i], sxy = X.sig[5][i];
@@ -179,30 +180,39 @@ bool Material::update_fused(MaterialBlock& b) const {
     for (int i = 0; i < n; ++i)
       if (b.failed[i]) return false;
   thread_local Columns X;
-  for (int i = 0; i < n; ++i) {
-    const double* L = b.L[i].data();  // column-major: L(r, c) at [r + 3 c]
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) X.L[3 * r + c][i] = L[r + 3 * c];
+  const double(*L)[kBlock] = b.L_rows ? b.L_rows : X.L;  // in place, or from the matrices
+  if (!b.L_rows)
+    for (int i = 0; i < n; ++i) {
+      const double* Li = b.L[i].data();  // column-major: L(r, c) at [r + 3 c]
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) X.L[3 * r + c][i] = Li[r + 3 * c];
+    }
+  for (int i = 0; i < n; ++i)
     for (int a = 0; a < 6; ++a) X.sig[a][i] = b.sigma[i][a];
-  }
   // A volume that would invert (1 + tr(D) dt <= 0, as kinematics() has it): the composed
   // update, which reports it (a NaN gradient shows in the results instead).
   const double dt = b.dt;
   double worst = 1.0;
 #pragma omp simd reduction(min : worst)
   for (int i = 0; i < n; ++i)
-    worst = std::min(worst, 1.0 + (dt * X.L[0][i] + dt * X.L[4][i] + dt * X.L[8][i]));
+    worst = std::min(worst, 1.0 + (dt * L[0][i] + dt * L[4][i] + dt * L[8][i]));
   if (!(worst > 0.0)) return false;
   const FusedModel& f = fused_;
   if (plastic)
-    f.mie_gruneisen ? fused_block<true, true>(f, b, X) : fused_block<true, false>(f, b, X);
+    f.mie_gruneisen ? fused_block<true, true>(f, b, L, X) : fused_block<true, false>(f, b, L, X);
   else
-    f.mie_gruneisen ? fused_block<false, true>(f, b, X) : fused_block<false, false>(f, b, X);
-  double sum = 0;  // finite when every value is (or, rarely, overflowing: the scan tells)
-  for (int i = 0; i < n; ++i) {
-    for (int a = 0; a < 6; ++a) b.sigma[i][a] = X.sig[a][i], sum += X.sig[a][i];
-    sum += b.rho[i] + b.e[i];
-  }
+    f.mie_gruneisen ? fused_block<false, true>(f, b, L, X) : fused_block<false, false>(f, b, L, X);
+  // Finite when every value is (or, rarely, overflowing: the scan tells). A vector of partial
+  // sums: one sum in particle order would be a chain of dependent additions, 8 a particle.
+  double sum = 0;
+  const double* __restrict rho = b.rho;
+  const double* __restrict e = b.e;
+#pragma omp simd reduction(+ : sum)
+  for (int i = 0; i < n; ++i)
+    sum += ((X.sig[0][i] + X.sig[1][i]) + (X.sig[2][i] + X.sig[3][i])) +
+           ((X.sig[4][i] + X.sig[5][i]) + (rho[i] + e[i]));
+  for (int i = 0; i < n; ++i)
+    for (int a = 0; a < 6; ++a) b.sigma[i][a] = X.sig[a][i];
   if (!std::isfinite(sum) && b.fault_index < 0)
     for (int i = 0; i < n; ++i)
       if (!std::isfinite(b.e[i]) || !b.sigma[i].allFinite() || !std::isfinite(b.rho[i])) {

@@ -160,6 +160,13 @@ double Material::shocked_signal_speed(double u_p) const {
 
 void Material::update(MaterialBlock& b, BlockScratch& S) const {
   if (fused() && !b.plane_stress && update_fused(b)) return;
+  if (!b.L) {  // the gradients one component an array: as matrices for the composed update
+    thread_local Mat3 L[kBlock];
+    for (int j = 0; j < b.n; ++j)
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) L[j](r, c) = b.L_rows[3 * r + c][j];
+    b.L = L;
+  }
   update_composed(b, S);
 }
 

@@ -37,9 +37,12 @@ enum class PointFault : std::uint8_t { None, VolumeInverted, NonFinite };
 /// and point into the particle columns (offset to the block) or into scratch.
 struct MaterialBlock {
   int n = 0;
-  double dt = 0;                   ///< s
-  double h = 0;                    ///< cell size, m (length scale of the bulk viscosity)
-  const Mat3* L = nullptr;         ///< velocity gradient, 1/s; 3x3 also in 2D (zeros out of plane)
+  double dt = 0;            ///< s
+  double h = 0;             ///< cell size, m (length scale of the bulk viscosity)
+  const Mat3* L = nullptr;  ///< velocity gradient, 1/s; 3x3 also in 2D (zeros out of plane)
+  /// Or the same one component an array (3D): L(r, c) of particle j at L_rows[3 r + c][j]; the
+  /// fused update reads it in place, the others take it as L (Material::update).
+  const double (*L_rows)[kBlock] = nullptr;
   const double* m = nullptr;       ///< mass, kg
   Sym* sigma = nullptr;            ///< Cauchy stress incl. bulk viscosity, Pa (in/out)
   double* rho = nullptr;           ///< density, kg/m^3 (in/out)
