@@ -183,7 +183,8 @@ class ExplicitSolver : public SolverCore<GridT> {
   template <G2pMode M>
   void advance_particle(const ParticleView<D>& p, std::uint32_t i, std::int64_t key,
                         const Vec<D>& xi, const std::int64_t* nd, int nk, const Vec<D>* a_c,
-                        const Vec<D>* v_c, double* N, ChunkSums& s, std::int64_t bin_key) const;
+                        const Vec<D>* v_c, double* N, ChunkSums& s, std::int64_t bin_key,
+                        double& leapfrog) const;
   void stress_block(const ParticleView<D>& p, PendingBlock& pb, StressScratch& scr, ChunkSums& s,
                     bool motion) const;
   /// A particle without stress in the stress pass: a rigid one advances with its own

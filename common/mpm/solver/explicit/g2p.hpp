@@ -65,7 +65,8 @@ void ExplicitSolver<GridT>::gather_from_grid() {
         return advance_in_field<M>(p, i, f, key, xi, nd, nk, first_visit, kRemapped, stats[unit],
                                    key);
     if (first_visit)
-      advance_particle<M>(p, i, key, xi, nd, nk, nullptr, nullptr, N, stats[unit], key);
+      advance_particle<M>(p, i, key, xi, nd, nk, nullptr, nullptr, N, stats[unit], key,
+                          stats[unit].leapfrog_kinetic);
     else
       grid_.values(key, xi, N);
     if constexpr (kRemapped) {
@@ -87,6 +88,7 @@ void ExplicitSolver<GridT>::gather_from_grid() {
       if constexpr (kMove || kPic) v_c[c] = v_i[nodes[c]];
       q_c[c].setZero();
     }
+    double leapfrog = 0;  // the bin's m v(k-1/2).v(k+1/2) / 2, in a register
     for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
       if (rigid(i)) {
         move_rigid(i, s, bin.key);
@@ -102,7 +104,7 @@ void ExplicitSolver<GridT>::gather_from_grid() {
           continue;
         }
       advance_particle<M>(p, i, key, xi, nd, nk, home ? a_c : nullptr, home ? v_c : nullptr, N, s,
-                          bin.key);
+                          bin.key, leapfrog);
       if constexpr (kRemapped) {
         const Vec<D> mv = p.m[i] * p.v[i];
         if (home) {
@@ -114,6 +116,7 @@ void ExplicitSolver<GridT>::gather_from_grid() {
         }
       }
     }
+    s.leapfrog_kinetic += leapfrog;
     if constexpr (kRemapped)
       for (int c = 0; c < nn; ++c) t.q[nodes[c] - t.offset] += q_c[c];
   };
@@ -133,14 +136,15 @@ void ExplicitSolver<GridT>::gather_from_grid() {
 
 /// The velocity (and when moving, position) update of particle i, in cell `key` at local
 /// coordinates xi, from the nodal values at the nodes nd of its cell (a_c, v_c: cached
-/// copies, or null to read the grid); returns its shape function values in N for the remap.
+/// copies, or null to read the grid); returns its shape function values in N for the remap,
+/// and adds m v(k-1/2).v(k+1/2) / 2 to `leapfrog` (a sum of s, or the caller's in a register).
 template <Grid GridT>
 template <typename ExplicitSolver<GridT>::G2pMode M>
 void ExplicitSolver<GridT>::advance_particle(const ParticleView<D>& p, std::uint32_t i,
                                              std::int64_t key, const Vec<D>& xi,
                                              const std::int64_t* nd, int nk, const Vec<D>* a_c,
                                              const Vec<D>* v_c, double* N, ChunkSums& s,
-                                             std::int64_t bin_key) const {
+                                             std::int64_t bin_key, double& leapfrog) const {
   constexpr bool kMove = M == G2pMode::Move, kPic = M == G2pMode::Pic;
   const double dt = dt_;
   grid_.values(key, xi, N);
@@ -150,11 +154,13 @@ void ExplicitSolver<GridT>::advance_particle(const ParticleView<D>& p, std::uint
     if constexpr (kMove || kPic) vbar += N[c] * (v_c ? v_c[c] : grid_.v[nd[c]]);
   }
   const Vec<D> v_old = p.v[i];
+  Vec<D> v_new;
   if constexpr (kPic)
-    p.v[i] = vbar;  // APIC: the grid's velocity; its affine part C_p in update_stress
+    v_new = vbar;  // APIC: the grid's velocity; its affine part C_p in update_stress
   else
-    p.v[i] += dt * a_p;  // (000, eq. 8)
-  s.leapfrog_kinetic += 0.5 * p.m[i] * v_old.dot(p.v[i]);
+    v_new = v_old + dt * a_p;  // (000, eq. 8)
+  p.v[i] = v_new;
+  leapfrog += 0.5 * p.m[i] * v_old.dot(v_new);
   if (loads_) s.add_load_work(p, i, dt, gravity_, v_old);
   if constexpr (kMove) {
     p.x[i] += dt * vbar;  // (000, eq. 7)
@@ -176,7 +182,7 @@ void ExplicitSolver<GridT>::advance_in_field(const ParticleView<D>& p, std::uint
   if (advance) {
     Vec<D> a_f[NMAX], v_f[NMAX];
     for (int c = 0; c < nk; ++c) a_f[c] = fd.a[nd[c]], v_f[c] = fd.v[nd[c]];
-    advance_particle<M>(p, i, key, xi, nd, nk, a_f, v_f, N, s, bin_key);
+    advance_particle<M>(p, i, key, xi, nd, nk, a_f, v_f, N, s, bin_key, s.leapfrog_kinetic);
   } else {
     grid_.values(key, xi, N);
   }

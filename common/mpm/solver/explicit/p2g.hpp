@@ -216,11 +216,13 @@ template <int F>
       for (int a = 0; a < 3; ++a)
         for (int r = 0; r < 3; ++r)
           for (int e = 0; e < 4; ++e) ts.s[a][r][e] += Vs[r][a] * W[a][e];
-      Vec<D> fb = m_p * gravity_;
-      if (p.f_ext) fb += p.f_ext[i];
-      if (p.f_rebar) fb += p.f_rebar[i];
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 8; ++c) ts.b[r][c] += fb[r] * N[c];
+      if (loads_ || p.f_rebar) {  // body force, loads, rebar (without, ts.b stays zero)
+        Vec<D> fb = m_p * gravity_;
+        if (p.f_ext) fb += p.f_ext[i];
+        if (p.f_rebar) fb += p.f_rebar[i];
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 8; ++c) ts.b[r][c] += fb[r] * N[c];
+      }
     }
   }
 }

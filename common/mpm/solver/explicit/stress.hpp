@@ -66,28 +66,28 @@ template <bool C>
         if (move) move_unstressed(p, i, bin.key, nodes, nn, C ? nullptr : v_c, s);
         continue;
       }
-      Mat<D> L;
-      Vec<D> vbar;
-      double v_r = 0;
-      if (const int j = int(i - bin.begin); fast && tb.home[j]) {
-        if constexpr (kTrilinear)
-          for (int r = 0; r < 3; ++r) {
-            for (int c = 0; c < 3; ++c) L(r, c) = tb.L[3 * r + c][j];
-            vbar[r] = tb.v[r][j];
-          }
-      } else {
-        general_sums<C>(p, i, bin.key, nodes, nn, other, vg_i, v_c, vg_c, move, remapped, L, vbar,
-                        v_r);
-      }
       if (pb.ends_before(i, p.material[i], h_cell)) {
         stress_block(p, pb, scr, s, move);
         pb.restart(i, p.material[i], h_cell);
       }
-      if constexpr (D == 3) {  // one component an array (MaterialBlock::L_rows)
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) scr.L_rows[3 * r + c][pb.k] = L(r, c);
+      Vec<D> vbar;
+      double v_r = 0;
+      if (const int j = int(i - bin.begin); fast && tb.home[j]) {
+        if constexpr (kTrilinear)  // straight into the block's columns (MaterialBlock::L_rows)
+          for (int r = 0; r < 3; ++r) {
+            for (int c = 0; c < 3; ++c) scr.L_rows[3 * r + c][pb.k] = tb.L[3 * r + c][j];
+            vbar[r] = tb.v[r][j];
+          }
       } else {
-        scr.L[pb.k].setZero(), scr.L[pb.k].template topLeftCorner<D, D>() = L;
+        Mat<D> L;
+        general_sums<C>(p, i, bin.key, nodes, nn, other, vg_i, v_c, vg_c, move, remapped, L, vbar,
+                        v_r);
+        if constexpr (D == 3) {  // one component an array (MaterialBlock::L_rows)
+          for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) scr.L_rows[3 * r + c][pb.k] = L(r, c);
+        } else {
+          scr.L[pb.k].setZero(), scr.L[pb.k].template topLeftCorner<D, D>() = L;
+        }
       }
       if (axi) scr.L[pb.k](2, 2) = v_r / p.x[i][0];  // hoop rate
       ++pb.k;
