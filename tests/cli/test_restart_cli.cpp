@@ -7,9 +7,14 @@
 // two spinning OpenMP threads make these many short runs slow.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
+#include <sstream>
 
 #include "mpm/stream/stream.hpp"
 #include "run_command.hpp"
@@ -224,9 +229,39 @@ TEST(Restart, KilledWithSigkillContinuesBitwise) {
   EXPECT_TRUE(slurp(out) == bar.bytes);
 }
 
+/// The numbers of `mpm-post history` text, row by row, and each column's unit (its
+/// "# units:" line) in `units`.
+std::vector<std::vector<double>> history_numbers(const std::string& text,
+                                                 std::vector<std::string>& units) {
+  std::vector<std::vector<double>> rows;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("# units: ", 0) == 0) {
+      std::istringstream cells(line.substr(9));
+      std::string unit;
+      units.clear();
+      while (std::getline(cells, unit, ',')) units.push_back(unit);
+    }
+    if (line.empty() || line[0] == '#' || !(std::isdigit(line[0]) || line[0] == '-')) continue;
+    std::vector<double> row;
+    std::istringstream cells(line);
+    std::string cell;
+    while (std::getline(cells, cell, ',')) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
 // SIGTERM: the run finishes its step, writes a checkpoint and a last frame, exits 143 saying
 // how to continue; the continued run has bitwise the frames and history rows of the
-// uninterrupted one (the file differs by the extra checkpoint and where HIST blocks break).
+// uninterrupted one (the file differs by the extra checkpoint and where HIST blocks break),
+// when the particles came due for their re-sort within the 20 steps the run waits for it. On a
+// loaded machine the signal can land late, on the bar come to rest, which re-sorts seldom: the
+// checkpoint then re-sorts it, says so, and the continued run differs at round-off: every
+// history column within 1e-9 of the largest value of its unit (the momentum along x is
+// round-off about zero: its scale is the momentum along z; round-off grown over some 1000
+// steps is below 1e-12 of it; a lost state value or a wrong clock shows at 1e-3 and more).
 TEST(Restart, SigtermStopsAfterACheckpointAndContinues) {
   // Ten times the steps: the signal, sent when the first frame is on disk (polled every 5 ms),
   // must find the run still going on a loaded machine (the 6 us run takes some 50 ms).
@@ -236,6 +271,7 @@ TEST(Restart, SigtermStopsAfterACheckpointAndContinues) {
   Result r = run(run_and_signal(bar.model, out, first_frame, "TERM"), bar.dir);
   ASSERT_NE(r.out.find("status 143"), std::string::npos) << r.out << r.err;
   EXPECT_NE(r.err.find("mpm-run --restart " + out.string()), std::string::npos) << r.err;
+  const bool resorted = r.err.find("so the checkpoint re-sorted them") != std::string::npos;
   r = run(post + " summary " + out.string(), bar.dir);
   EXPECT_NE(r.out.find("status 143"), std::string::npos) << r.out;
   r = run(runner + " --restart " + out.string() + " --threads 1 --progress none", bar.dir);
@@ -243,12 +279,33 @@ TEST(Restart, SigtermStopsAfterACheckpointAndContinues) {
   EXPECT_NE(r.err.find("stopped: interrupted by signal 15"), std::string::npos) << r.err;
   const auto a = frames_of(bar.full), b = frames_of(out);
   ASSERT_EQ(a.size(), b.size());
-  for (std::size_t k = 0; k < a.size(); ++k) EXPECT_TRUE(a[k] == b[k]) << "frame " << k;
-  const Result ha = run(post + " history " + bar.full.string(), bar.dir);
-  const Result hb = run(post + " history " + out.string(), bar.dir);
+  const Result ha = run(post + " history --digits 17 " + bar.full.string(), bar.dir);
+  const Result hb = run(post + " history --digits 17 " + out.string(), bar.dir);
   ASSERT_EQ(hb.status, 0) << hb.err;
   EXPECT_GT(ha.out.size(), 1000u);
-  EXPECT_TRUE(ha.out == hb.out) << "history rows";
+  if (!resorted) {
+    for (std::size_t k = 0; k < a.size(); ++k) EXPECT_TRUE(a[k] == b[k]) << "frame " << k;
+    EXPECT_TRUE(ha.out == hb.out) << "history rows";
+    return;
+  }
+  std::vector<std::string> units, units_b;
+  const auto ra = history_numbers(ha.out, units), rb = history_numbers(hb.out, units_b);
+  ASSERT_EQ(ra.size(), rb.size());
+  ASSERT_GT(ra.size(), 100u);
+  ASSERT_EQ(units.size(), ra[0].size());
+  std::map<std::string, double> scale;  // by unit
+  for (const auto& row : ra)
+    for (std::size_t c = 0; c < row.size(); ++c)
+      scale[units[c]] = std::max(scale[units[c]], std::abs(row[c]));
+  for (std::size_t c = 0; c < ra[0].size(); ++c) {
+    double worst = 0;
+    for (std::size_t k = 0; k < ra.size(); ++k) {
+      ASSERT_EQ(ra[k].size(), rb[k].size()) << "row " << k;
+      worst = std::max(worst, std::abs(ra[k][c] - rb[k][c]));
+    }
+    EXPECT_LE(worst, 1e-9 * scale[units[c]])
+        << "history column " << c << " (" << units[c] << "; re-sorted at the checkpoint)";
+  }
 }
 
 // What cannot be continued is refused with exit 2 and a reason.

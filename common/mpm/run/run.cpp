@@ -389,10 +389,16 @@ class TimeLoop {
     if (comm_.parallel()) g_signal = int(comm_.max(g_signal));  // every rank stops at once
     if (!g_signal) return false;
     if (!kImplicit && !solver_.sort_pending() && ++signal_wait_ <= kSignalWait) return false;
+    const bool on_schedule = kImplicit || solver_.sort_pending();
     write_checkpoint();
     status_ = 128 + g_signal;
     message_ = "interrupted by signal " + std::to_string(int(g_signal)) +
                " at t = " + std::to_string(solver_.time()) + " s; the last frame is the state then";
+    if (!on_schedule)
+      message_ += " (the particles were not due for a re-sort within " +
+                  std::to_string(kSignalWait) +
+                  " steps, so the checkpoint re-sorted them: a continued run differs from an "
+                  "uninterrupted one at round-off)";
     message_ += opt_.output == "-"
                     ? "; the stream holds a checkpoint of it: saved to a file, it continues "
                       "with mpm-run --restart FILE"
