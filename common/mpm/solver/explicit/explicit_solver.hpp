@@ -186,7 +186,7 @@ class ExplicitSolver : public SolverCore<GridT> {
                         const Vec<D>* v_c, double* N, ChunkSums& s, std::int64_t bin_key,
                         double& leapfrog) const;
   void stress_block(const ParticleView<D>& p, PendingBlock& pb, StressScratch& scr, ChunkSums& s,
-                    bool motion) const;
+                    bool rows, bool motion) const;
   /// A particle without stress in the stress pass: a rigid one advances with its own
   /// velocity, a rebar node with the grid's (v_c: its bin's cached nodal velocities or null).
   [[gnu::noinline, gnu::cold]] void move_unstressed(const ParticleView<D>& p, std::uint32_t i,

@@ -45,6 +45,7 @@ template <bool C>
   const double dt = dt_;
   const bool axi = axisymmetric_, move = positions == Positions::Move;
   PendingBlock pb;
+  bool rows = false;  // the pending block's gradients one component an array (a fused material)
   TrilinearBin tb;
   for (std::uint32_t bi = chunks[ch].bin_begin; bi < chunks[ch].bin_end; ++bi) {
     const Bin& bin = bins[bi];
@@ -67,22 +68,28 @@ template <bool C>
         continue;
       }
       if (pb.ends_before(i, p.material[i], h_cell)) {
-        stress_block(p, pb, scr, s, move);
+        stress_block(p, pb, scr, s, rows, move);
         pb.restart(i, p.material[i], h_cell);
+        // The fused update reads the gradients as columns in place (3D; materials.cpp); the
+        // composed one takes matrices.
+        rows = D == 3 && materials_[pb.mat].fused();
       }
       Vec<D> vbar;
       double v_r = 0;
       if (const int j = int(i - bin.begin); fast && tb.home[j]) {
-        if constexpr (kTrilinear)  // straight into the block's columns (MaterialBlock::L_rows)
+        if constexpr (kTrilinear)  // straight into the block's columns or matrices
           for (int r = 0; r < 3; ++r) {
-            for (int c = 0; c < 3; ++c) scr.L_rows[3 * r + c][pb.k] = tb.L[3 * r + c][j];
+            if (rows)
+              for (int c = 0; c < 3; ++c) scr.L_rows[3 * r + c][pb.k] = tb.L[3 * r + c][j];
+            else
+              for (int c = 0; c < 3; ++c) scr.L[pb.k](r, c) = tb.L[3 * r + c][j];
             vbar[r] = tb.v[r][j];
           }
       } else {
         Mat<D> L;
         general_sums<C>(p, i, bin.key, nodes, nn, other, vg_i, v_c, vg_c, move, remapped, L, vbar,
                         v_r);
-        if constexpr (D == 3) {  // one component an array (MaterialBlock::L_rows)
+        if (rows) {
           for (int r = 0; r < 3; ++r)
             for (int c = 0; c < 3; ++c) scr.L_rows[3 * r + c][pb.k] = L(r, c);
         } else {
@@ -97,7 +104,7 @@ template <bool C>
       }
     }
   }
-  stress_block(p, pb, scr, s, move);
+  stress_block(p, pb, scr, s, rows, move);
 }
 
 /// The velocity gradient L = sum_i v_i (x) G_ip (000, eqs. 12-13 use its parts), the move
@@ -242,12 +249,14 @@ void ExplicitSolver<GridT>::move_unstressed(const ParticleView<D>& p, std::uint3
 }
 
 /// The material update of the pending block (then empty), its internal energy and stable
-/// steps into s, and the first fault; with `motion` also its kinetic energy and momentum.
+/// steps into s, and the first fault; with `motion` also its kinetic energy and momentum. Its
+/// velocity gradients are in scr.L_rows when `rows`, else in scr.L.
 template <Grid GridT>
 void ExplicitSolver<GridT>::stress_block(const ParticleView<D>& p, PendingBlock& pb,
-                                         StressScratch& scr, ChunkSums& s, bool motion) const {
+                                         StressScratch& scr, ChunkSums& s, bool rows,
+                                         bool motion) const {
   if (pb.k == 0) return;
-  const MaterialBlock blk = update_block(pb, p, scr, D == 3);
+  const MaterialBlock blk = update_block(pb, p, scr, rows);
   // In registers, not through s: the block's internal energy, and its fastest signal
   // (min_j h / s_j is h / max_j s_j exactly: a division is monotone, one is enough); partial
   // sums and maxima a vector of particles at a time (in a fixed order: the same bits each run).
