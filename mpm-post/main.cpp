@@ -31,15 +31,20 @@ CLI::App* add_scene(CLI::App& app, mpm::SceneArgs& a) {
   return sub;
 }
 
+/// --digits of the CSV commands: significant digits of the values written.
+void add_digits(CLI::App* sub, int& digits) {
+  sub->add_option("--digits", digits, "significant digits (17: every bit of a double)")
+      ->check(CLI::Range(1, 17))
+      ->capture_default_str();
+}
+
 CLI::App* add_history(CLI::App& app, mpm::HistoryArgs& a) {
   auto* sub =
       app.add_subcommand("history", "time histories as CSV (energies, momentum, wall forces)");
   sub->add_option("input", a.input, "stream, - for stdin")->capture_default_str();
   sub->add_option("-o,--output", a.output, "CSV file, - for stdout")->capture_default_str();
   sub->add_option("--columns", a.columns, "columns to print (default all)")->delimiter(',');
-  sub->add_option("--digits", a.digits, "significant digits (17: every bit of a double)")
-      ->check(CLI::Range(1, 17))
-      ->capture_default_str();
+  add_digits(sub, a.digits);
   return sub;
 }
 
@@ -51,9 +56,7 @@ CLI::App* add_particles(CLI::App& app, mpm::ParticlesArgs& a) {
   sub->add_option("--frame", a.frame, "frame index (0 = first) or 'last'")->capture_default_str();
   sub->add_option("--columns", a.columns, "particle columns (default all), e.g. x,sigma")
       ->delimiter(',');
-  sub->add_option("--digits", a.digits, "significant digits (17: every bit of a double)")
-      ->check(CLI::Range(1, 17))
-      ->capture_default_str();
+  add_digits(sub, a.digits);
   return sub;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
-// Runs a shell command for the CLI tests, capturing its exit status, stdout and stderr.
+// Runs a shell command for the CLI tests, capturing its exit status, stdout and stderr; reads
+// a result stream's history rows.
 #include <sys/wait.h>
 
 #include <cmath>
@@ -9,6 +10,8 @@
 #include <regex>
 #include <sstream>
 #include <string>
+
+#include "mpm/stream/stream.hpp"
 
 namespace mpm::testing {
 
@@ -51,6 +54,22 @@ inline double json_value(const std::string& json, const std::string& key) {
   const std::regex re("\"" + key + "\": ([-0-9.eE+]+)");
   if (!std::regex_search(json, m, re)) return NAN;
   return std::stod(m[1]);
+}
+
+/// Appends a HIST record's rows to `all` (its names and units from the first record).
+inline void append_history(HistoryBlock& all, HistoryBlock&& b) {
+  if (all.names.empty()) all.names = std::move(b.names), all.units = std::move(b.units);
+  all.values.insert(all.values.end(), b.values.begin(), b.values.end());
+}
+
+/// Every history row of a result stream.
+inline HistoryBlock history_of(const std::filesystem::path& result) {
+  HistoryBlock all;
+  StreamVisitor v;
+  v.want_frames = false;
+  v.history = [&](HistoryBlock&& b) { append_history(all, std::move(b)); };
+  read_stream(result.string(), v);
+  return all;
 }
 
 inline const std::string prep = MPM_PREP;

@@ -43,10 +43,7 @@ RunOut read_run(const fs::path& p) {
   StreamVisitor v;
   v.frame = [&](Frame&& f) { r.frames.push_back(std::move(f)); };
   v.escapes = [&](Frame&& f) { r.escapes.push_back(std::move(f)); };
-  v.history = [&](HistoryBlock&& h) {
-    if (r.history.names.empty()) r.history.names = h.names, r.history.units = h.units;
-    r.history.values.insert(r.history.values.end(), h.values.begin(), h.values.end());
-  };
+  v.history = [&](HistoryBlock&& h) { append_history(r.history, std::move(h)); };
   const StreamSummary s = read_stream(p.string(), v);
   EXPECT_TRUE(s.damage.empty()) << s.damage;
   r.status = s.ended ? s.end_status : -1;

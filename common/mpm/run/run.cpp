@@ -297,24 +297,16 @@ class TimeLoop {
     if (comm_.parallel()) {
       gather_by_id(comm_, solver_.particles(), gathered_);
       if (!comm_.root()) return;
-      std::swap(f.columns, gathered_);
-      try {
-        write(f);
-      } catch (...) {
-        std::swap(f.columns, gathered_);
-        throw;
-      }
-      std::swap(f.columns, gathered_);
-      return;
     }
-    std::swap(f.columns, solver_.particles());
+    ColumnStore& cols = comm_.parallel() ? gathered_ : solver_.particles();
+    std::swap(f.columns, cols);
     try {
       write(f);
     } catch (...) {
-      std::swap(f.columns, solver_.particles());
+      std::swap(f.columns, cols);
       throw;
     }
-    std::swap(f.columns, solver_.particles());
+    std::swap(f.columns, cols);
   }
   void emit_frame(std::uint32_t flags) {
     ScopedTimer timer(solver_.timers(), t_output_);
@@ -323,10 +315,8 @@ class TimeLoop {
     emit_grid();
     write_particles(flags, [&](const Frame& f) { out_->write_frame(f, o_.fields, o_.precision); });
     if (rebar_) write_rebar(flags);  // the elements' state at the frame (after it)
-    if (!comm_.parallel())
-      extremes_.sample(solver_.particles(), solver_.time());
-    else if (comm_.root())
-      extremes_.sample(gathered_, solver_.time());
+    if (comm_.root())                // one process's particles, or every rank's gathered there
+      extremes_.sample(comm_.parallel() ? gathered_ : solver_.particles(), solver_.time());
     gathered_ = ColumnStore();
   }
   /// History rows to the stream (the root's; the other ranks computed the same rows).
