@@ -9,7 +9,9 @@
 /// receives its contributions in one fixed order: results are bitwise identical for any
 /// number of threads.
 #include <algorithm>
+#include <array>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "mpm/core/columns.hpp"
@@ -21,6 +23,10 @@ namespace mpm {
 struct Bin {
   std::uint32_t begin = 0, end = 0;  ///< particle range
   std::int64_t key = -1;             ///< cell key (= index of the cell's lower corner node)
+  /// The cell's global index along each axis, on grids of square cells counted from the
+  /// domain's origin (CellLattice): a particle is in the cell when c <= (x - origin) / h < c + 1
+  /// (ExplicitSolver::in_bin_cell); unused elsewhere.
+  std::array<double, 3> cell{};
 };
 
 struct Chunk {
@@ -102,12 +108,20 @@ void Binning::sort(ColumnStore& cols, GridT& grid, const std::vector<std::uint32
   for (std::size_t i = 0; identity && i < kept; ++i) identity = perm_[i] == i;
   if (!identity) cols.gather(perm_);
 
-  // Bins: runs of equal keys.
+  // Bins: runs of equal keys (a bin's cell: its first particle's).
   bins_.clear();
+  const Vec<D>* xs = cols.get<Vec<D>>(col::x);
   for (std::size_t i = 0; i < kept; ++i) {
     const std::uint32_t k = keys_[perm_[i]];
-    if (bins_.empty() || bins_.back().key != k)
+    if (bins_.empty() || bins_.back().key != k) {
       bins_.push_back({std::uint32_t(i), std::uint32_t(i), k});
+      if constexpr (std::is_base_of_v<CellLattice<D>, GridT>) {
+        IVec<D> cell;
+        Vec<D> xi;
+        grid.CellLattice<D>::locate(xs[i], cell, xi);
+        for (int a = 0; a < D; ++a) bins_.back().cell[std::size_t(a)] = cell[a];
+      }
+    }
     bins_.back().end = std::uint32_t(i + 1);
   }
 

@@ -148,6 +148,45 @@ class ExplicitSolver : public SolverCore<GridT> {
     }
     grid_.locate(x, key, xi);
   }
+  /// Uniform and sparse 3D cells: whether x lies in the bin's cell, and its local coordinates
+  /// there. locate's r = (x - origin) / h has floor(r) = c exactly when c <= r < c + 1, and
+  /// then its xi = r - floor(r) is r - c: the same answer and the same xi without the floor,
+  /// the conversion and the key (false for NaN); a vector of particles at a time where the
+  /// caller loops over a bin (trilinear_sums, track_bin). (r is compared, so it is rounded
+  /// before r - c: no fused multiply-add there.)
+  [[gnu::always_inline]] bool in_bin_cell(const Bin& bin, const Vec<D>& x, Vec<D>& xi) const {
+    bool in = kTrilinear;
+    if constexpr (kTrilinear)
+      for (int a = 0; a < D; ++a) {
+        const double r = (x[a] - grid_.origin()[a]) * grid_.inv_h(), c = bin.cell[std::size_t(a)];
+        in = in & (r >= c) & (r < c + 1.0);
+        xi[a] = r - c;
+      }
+    return in;
+  }
+  /// in_bin_cell's constants for loops over a bin in plain doubles.
+  struct BinCell {
+    double o[3], ih, c[3];
+  };
+  BinCell bin_cell(const Bin& bin) const {
+    BinCell b{};
+    if constexpr (kTrilinear) {
+      b.ih = grid_.inv_h();
+      for (int a = 0; a < 3; ++a) b.o[a] = grid_.origin()[a], b.c[a] = bin.cell[std::size_t(a)];
+    }
+    return b;
+  }
+  /// A particle of a bin: its cell and local coordinates (the bin's, when it is still there).
+  [[gnu::always_inline]] void locate_in_bin(const Bin& bin, const Vec<D>& x, std::int64_t& key,
+                                            Vec<D>& xi) const {
+    if constexpr (kTrilinear) {
+      if (in_bin_cell(bin, x, xi)) {
+        key = bin.key;
+        return;
+      }
+    }
+    locate_in_bin(bin.key, x, key, xi);
+  }
   /// A particle of a bin, located: its cell and local coordinates there, and that cell's nodes.
   struct InBin {
     std::int64_t key;
@@ -156,11 +195,11 @@ class ExplicitSolver : public SolverCore<GridT> {
     int nk;                  ///< nodes of its cell
     const std::int64_t* nd;  ///< the bin's nodes at home, else `other` (filled)
   };
-  [[gnu::always_inline]] InBin locate_in_bin(std::int64_t bin_key, const std::int64_t* nodes,
-                                             int nn, const Vec<D>& x, std::int64_t* other) const {
+  [[gnu::always_inline]] InBin locate_in_bin(const Bin& bin, const std::int64_t* nodes, int nn,
+                                             const Vec<D>& x, std::int64_t* other) const {
     InBin at;
-    locate_in_bin(bin_key, x, at.key, at.xi);
-    at.home = at.key == bin_key;
+    locate_in_bin(bin, x, at.key, at.xi);
+    at.home = at.key == bin.key;
     at.nk = at.home ? nn : grid_.cell_nodes(at.key, other);
     at.nd = at.home ? nodes : other;
     return at;
@@ -190,13 +229,13 @@ class ExplicitSolver : public SolverCore<GridT> {
   /// A particle without stress in the stress pass: a rigid one advances with its own
   /// velocity, a rebar node with the grid's (v_c: its bin's cached nodal velocities or null).
   [[gnu::noinline, gnu::cold]] void move_unstressed(const ParticleView<D>& p, std::uint32_t i,
-                                                    std::int64_t bin_key, const std::int64_t* nodes,
+                                                    const Bin& bin, const std::int64_t* nodes,
                                                     int nn, const Vec<D>* v_c, ChunkSums& s);
   template <bool C>
   void stress_chunk(const ParticleView<D>& p, int ch, const Vec<D>* vg_i, Positions positions,
                     bool remapped, ChunkSums& s);
   template <bool C>
-  void general_sums(const ParticleView<D>& p, std::uint32_t i, std::int64_t bin_key,
+  void general_sums(const ParticleView<D>& p, std::uint32_t i, const Bin& bin,
                     const std::int64_t* nodes, int nn, std::int64_t* other, const Vec<D>* vg_i,
                     const Vec<D>* v_c, const Vec<D>* vg_c, bool move, bool remapped, Mat<D>& L,
                     Vec<D>& vbar, double& v_r);
@@ -207,14 +246,26 @@ class ExplicitSolver : public SolverCore<GridT> {
   /// The velocity gradients (L(r, c) in L[3 r + c]) and move velocities of a bin's particles,
   /// one array per component, and which of them are still in the bin's cell.
   struct TrilinearBin {
-    static constexpr int kMax = 32;  ///< larger bins take the general sums
-    alignas(64) double x[3][kMax];   ///< local coordinates in the bin's cell
+    static constexpr int kMax = 32;   ///< larger bins take the general sums
+    static constexpr int kLanes = 8;  ///< AVX-512's doubles (twice AVX2's): kMax's divisor
+    /// Lanes a bin's loops run: n rounded up to whole vectors.
+    static int lanes(int n) { return (n + kLanes - 1) / kLanes * kLanes; }
+    /// Copies n positions into x one axis an array, the lanes up to whole vectors with the
+    /// first; returns the lanes.
+    int positions(const Vec<3>* xp, int n) {
+      const int nv = lanes(n);
+      for (int j = 0; j < nv; ++j)
+        for (int a = 0; a < 3; ++a) x[a][j] = xp[j < n ? j : 0][a];
+      return nv;
+    }
+    alignas(64) double x[3][kMax];  ///< local coordinates in the bin's cell
     alignas(64) double L[9][kMax];
     alignas(64) double v[3][kMax];
     bool home[kMax];
   };
   void trilinear_sums(const ParticleView<D>& p, const Bin& bin, const Vec<D>* vg, const Vec<D>* v,
                       TrilinearBin& tb) const;
+  void track_bin(const ParticleView<D>& p, const Bin& bin, TrilinearBin& tb, ChunkSums& s) const;
   /// p2g's sums over a bin's particles in its cell (p2g.hpp): mass and momentum and body force
   /// by corner, the stress by axis, component and edge along the axis.
   struct TrilinearSums {

@@ -94,7 +94,7 @@ void ExplicitSolver<GridT>::gather_from_grid() {
         move_rigid(i, s, bin.key);
         continue;
       }
-      const auto [key, xi, home, nk, nd] = locate_in_bin(bin.key, nodes, nn, p.x[i], other);
+      const auto [key, xi, home, nk, nd] = locate_in_bin(bin, nodes, nn, p.x[i], other);
       double N[NMAX];
       if constexpr (C)
         if (const int f = contact_.field_of(p.body[i])) {

@@ -145,7 +145,7 @@ void ExplicitSolver<GridT>::scatter_to_grid() {
       if (rigid(i)) continue;
       std::int64_t key;
       Vec<D> xi;
-      locate_in_bin(bin.key, p.x[i], key, xi);
+      locate_in_bin(bin, p.x[i], key, xi);
       if (trilinear && key == bin.key) {
         trilinear_add<F>(p, i, xi, ts);
         continue;

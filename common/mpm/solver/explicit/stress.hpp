@@ -64,7 +64,7 @@ template <bool C>
     if (fast) trilinear_sums(p, bin, vg_c, move ? v_c : nullptr, tb);
     for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
       if (p.material[i] >= kRebarNode) [[unlikely]] {  // rigid particles and rebar nodes
-        if (move) move_unstressed(p, i, bin.key, nodes, nn, C ? nullptr : v_c, s);
+        if (move) move_unstressed(p, i, bin, nodes, nn, C ? nullptr : v_c, s);
         continue;
       }
       if (pb.ends_before(i, p.material[i], h_cell)) {
@@ -87,8 +87,7 @@ template <bool C>
           }
       } else {
         Mat<D> L;
-        general_sums<C>(p, i, bin.key, nodes, nn, other, vg_i, v_c, vg_c, move, remapped, L, vbar,
-                        v_r);
+        general_sums<C>(p, i, bin, nodes, nn, other, vg_i, v_c, vg_c, move, remapped, L, vbar, v_r);
         if (rows) {
           for (int r = 0; r < 3; ++r)
             for (int c = 0; c < 3; ++c) scr.L_rows[3 * r + c][pb.k] = L(r, c);
@@ -100,11 +99,39 @@ template <bool C>
       ++pb.k;
       if (move) {             // (the block's kinetic energy and momentum: stress_block)
         p.x[i] += dt * vbar;  // (000, eq. 7)
-        track_move(p.x[i], i, bin.key, s);
+        if (!fast) track_move(p.x[i], i, bin.key, s);
       }
     }
+    if (fast && move) track_bin(p, bin, tb, s);
   }
   stress_block(p, pb, scr, s, rows, move);
+}
+
+/// Uniform and sparse 3D cells, after the move: a vector pass over the bin finds the particles
+/// still in its cell (finite, in the domain and the window, in the bin: nothing to book), and
+/// only the others go through track_move. Rigid particles and rebar nodes were tracked as they
+/// moved (move_unstressed).
+template <Grid GridT>
+void ExplicitSolver<GridT>::track_bin(const ParticleView<D>& p, const Bin& bin, TrilinearBin& tb,
+                                      ChunkSums& s) const {
+  if constexpr (kTrilinear) {
+    const int n = int(bin.end - bin.begin), nv = tb.positions(p.x + bin.begin, n);
+    const BinCell bc = bin_cell(bin);
+    bool stayed[TrilinearBin::kMax];
+#pragma omp simd
+    for (int j = 0; j < nv; ++j) {  // (as trilinear_sums)
+      bool in = true;
+      for (int a = 0; a < 3; ++a) {
+        const double r = (tb.x[a][j] - bc.o[a]) * bc.ih;
+        in = in & (r >= bc.c[a]) & (r < bc.c[a] + 1.0);
+      }
+      stayed[j] = in;
+    }
+    for (int j = 0; j < n; ++j)
+      if (const std::uint32_t i = bin.begin + std::uint32_t(j);
+          !stayed[j] && p.material[i] < kRebarNode)
+        track_move(p.x[i], i, bin.key, s);
+  }
 }
 
 /// The velocity gradient L = sum_i v_i (x) G_ip (000, eqs. 12-13 use its parts), the move
@@ -113,13 +140,13 @@ template <bool C>
 template <Grid GridT>
 template <bool C>
 [[gnu::always_inline]] inline void ExplicitSolver<GridT>::general_sums(
-    const ParticleView<D>& p, std::uint32_t i, std::int64_t bin_key, const std::int64_t* nodes,
-    int nn, std::int64_t* other, const Vec<D>* vg_i, const Vec<D>* v_c, const Vec<D>* vg_c,
-    bool move, bool remapped, Mat<D>& L, Vec<D>& vbar, double& v_r) {
+    const ParticleView<D>& p, std::uint32_t i, const Bin& bin, const std::int64_t* nodes, int nn,
+    std::int64_t* other, const Vec<D>* vg_i, const Vec<D>* v_c, const Vec<D>* vg_c, bool move,
+    bool remapped, Mat<D>& L, Vec<D>& vbar, double& v_r) {
   const double dt = dt_;
   const bool axi = axisymmetric_;
   const Vec<D>* v_i = grid_.v.data();
-  const auto [key, xi, home, nk, nd] = locate_in_bin(bin_key, nodes, nn, p.x[i], other);
+  const auto [key, xi, home, nk, nd] = locate_in_bin(bin, nodes, nn, p.x[i], other);
   double N[NMAX];
   Vec<D> G[NMAX];
   grid_.shape(key, xi, N, G);
@@ -171,13 +198,22 @@ void ExplicitSolver<GridT>::trilinear_sums(const ParticleView<D>& p, const Bin& 
                                            const Vec<D>* vg, const Vec<D>* v,
                                            TrilinearBin& tb) const {
   if constexpr (kTrilinear) {
-    const int n = int(bin.end - bin.begin);
-    for (int j = 0; j < n; ++j) {
-      std::int64_t key;
-      Vec<D> xi;
-      grid_.locate(p.x[bin.begin + j], key, xi);
-      tb.home[j] = key == bin.key;
-      for (int a = 0; a < 3; ++a) tb.x[a][j] = xi[a];
+    // Whole vectors over positions one axis an array: a bin holds about 8 particles, and the
+    // compiler's vector loop over the particles' interleaved coordinates wants more than a
+    // vector's worth (the rest ran scalar). Lanes past the bin repeat its first particle.
+    // (in_bin_cell's test and xi, in plain doubles: the compiler vectorises no Eigen vector
+    // built in the loop.)
+    const int n = int(bin.end - bin.begin), nv = tb.positions(p.x + bin.begin, n);
+    const BinCell bc = bin_cell(bin);
+#pragma omp simd
+    for (int j = 0; j < nv; ++j) {
+      bool in = true;
+      for (int a = 0; a < 3; ++a) {
+        const double r = (tb.x[a][j] - bc.o[a]) * bc.ih;
+        in = in & (r >= bc.c[a]) & (r < bc.c[a] + 1.0);
+        tb.x[a][j] = r - bc.c[a];
+      }
+      tb.home[j] = in;
     }
     // Corner c = bx + 2 by + 4 bz. Differences across x on the edges e = by + 2 bz, across y
     // on e = bx + 2 bz, across z on e = bx + 2 by.
@@ -191,7 +227,7 @@ void ExplicitSolver<GridT>::trilinear_sums(const ParticleView<D>& p, const Bin& 
       }
     const double ih = grid_.inv_h();
 #pragma omp simd
-    for (int j = 0; j < n; ++j) {
+    for (int j = 0; j < nv; ++j) {
       const double x1 = tb.x[0][j], y1 = tb.x[1][j], z1 = tb.x[2][j];
       const double x0 = 1.0 - x1, y0 = 1.0 - y1, z0 = 1.0 - z1;
       const double yz[4] = {y0 * z0, y1 * z0, y0 * z1, y1 * z1};
@@ -208,16 +244,14 @@ void ExplicitSolver<GridT>::trilinear_sums(const ParticleView<D>& p, const Bin& 
     }
     if (!v) return;
 #pragma omp simd
-    for (int j = 0; j < n; ++j) {
+    for (int j = 0; j < nv; ++j) {  // (named weights: an array here kept the loop scalar)
       const double x1 = tb.x[0][j], y1 = tb.x[1][j], z1 = tb.x[2][j];
       const double x0 = 1.0 - x1, y0 = 1.0 - y1, z0 = 1.0 - z1;
-      const double N[8] = {x0 * y0 * z0, x1 * y0 * z0, x0 * y1 * z0, x1 * y1 * z0,
-                           x0 * y0 * z1, x1 * y0 * z1, x0 * y1 * z1, x1 * y1 * z1};
-      for (int r = 0; r < 3; ++r) {
-        double sum = 0;
-        for (int c = 0; c < 8; ++c) sum += N[c] * v[c][r];
-        tb.v[r][j] = sum;
-      }
+      const double N0 = x0 * y0 * z0, N1 = x1 * y0 * z0, N2 = x0 * y1 * z0, N3 = x1 * y1 * z0,
+                   N4 = x0 * y0 * z1, N5 = x1 * y0 * z1, N6 = x0 * y1 * z1, N7 = x1 * y1 * z1;
+      for (int r = 0; r < 3; ++r)
+        tb.v[r][j] = N0 * v[0][r] + N1 * v[1][r] + N2 * v[2][r] + N3 * v[3][r] + N4 * v[4][r] +
+                     N5 * v[5][r] + N6 * v[6][r] + N7 * v[7][r];
     }
   }
 }
@@ -227,15 +261,15 @@ void ExplicitSolver<GridT>::trilinear_sums(const ParticleView<D>& p, const Bin& 
 /// body's field with contact.
 template <Grid GridT>
 void ExplicitSolver<GridT>::move_unstressed(const ParticleView<D>& p, std::uint32_t i,
-                                            std::int64_t bin_key, const std::int64_t* nodes, int nn,
+                                            const Bin& bin, const std::int64_t* nodes, int nn,
                                             const Vec<D>* v_c, ChunkSums& s) {
   if (rigid(i)) {
     p.x[i] += dt_ * p.v[i];
-    track_move(p.x[i], i, bin_key, s);
+    track_move(p.x[i], i, bin.key, s);
     return;
   }
   std::int64_t other[NMAX];
-  const auto [key, xi, home, nk, nd] = locate_in_bin(bin_key, nodes, nn, p.x[i], other);
+  const auto [key, xi, home, nk, nd] = locate_in_bin(bin, nodes, nn, p.x[i], other);
   double N[NMAX];
   grid_.values(key, xi, N);
   const Vec<D>* v_i = grid_.v.data();
@@ -245,7 +279,7 @@ void ExplicitSolver<GridT>::move_unstressed(const ParticleView<D>& p, std::uint3
   for (int c = 0; c < nk; ++c) vbar += N[c] * (home && v_c ? v_c[c] : v_i[nd[c]]);
   p.x[i] += dt_ * vbar;  // (000, eq. 7)
   s.add_motion(p, i);
-  track_move(p.x[i], i, bin_key, s);
+  track_move(p.x[i], i, bin.key, s);
 }
 
 /// The material update of the pending block (then empty), its internal energy and stable
