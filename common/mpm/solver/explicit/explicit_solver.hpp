@@ -15,6 +15,7 @@
 #include "mpm/scene/scene.hpp"
 #include "mpm/solver/core.hpp"
 #include "mpm/solver/explicit/contact_fields.hpp"
+#include "mpm/solver/explicit/lanes.hpp"
 #include "mpm/solver/explicit/rebar.hpp"
 #include "mpm/solver/explicit/scatter.hpp"
 
@@ -269,7 +270,8 @@ class ExplicitSolver : public SolverCore<GridT> {
   /// p2g's sums over a bin's particles in its cell (p2g.hpp): mass and momentum and body force
   /// by corner, the stress by axis, component and edge along the axis.
   struct TrilinearSums {
-    double m[8], p[3][8], b[3][8], s[3][3][4];
+    lanes::V8 m, p[3], b[3];  ///< by corner (lanes.hpp)
+    lanes::V4 s[3][3];        ///< by axis, component, edge
   };
   template <int F>
   void trilinear_add(const ParticleView<D>& p, std::uint32_t i, const Vec<D>& xi,

@@ -188,17 +188,14 @@ template <int F>
                                                                         const Vec<D>& xi,
                                                                         TrilinearSums& ts) const {
   if constexpr (kTrilinear) {
-    const double w[3][2] = {{1.0 - xi[0], xi[0]}, {1.0 - xi[1], xi[1]}, {1.0 - xi[2], xi[2]}};
-    double N[8];
-    shape_values<3>(xi, N);
+    // In vectors over the corners and edges (lanes.hpp).
+    using lanes::spread4;
+    const double x1 = xi[0], y1 = xi[1], z1 = xi[2], x0 = 1.0 - x1, y0 = 1.0 - y1, z0 = 1.0 - z1;
+    const lanes::V8 N = lanes::corner_weights(x1, y1, z1);
     const double m_p = p.m[i];
-    if constexpr (F & kMass)
-      for (int c = 0; c < 8; ++c) ts.m[c] += m_p * N[c];
+    if constexpr (F & kMass) ts.m += m_p * N;
     if constexpr (F & kMomentum)
-      for (int r = 0; r < 3; ++r) {
-        const double mv = m_p * p.v[i][r];
-        for (int c = 0; c < 8; ++c) ts.p[r][c] += mv * N[c];
-      }
+      for (int r = 0; r < 3; ++r) ts.p[r] += (m_p * p.v[i][r]) * N;
     if constexpr (F & kForce) {
       const double V = m_p / p.rho[i];
       const Sym& sg = p.sigma[i];
@@ -207,21 +204,16 @@ template <int F>
                                {V * sg[4], V * sg[3], V * sg[2]}};
       // The other two axes' weights on the edges along each axis a: along x, e = by + 2 bz;
       // along y, e = bx + 2 bz; along z, e = bx + 2 by.
-      double W[3][4];
-      for (int e = 0; e < 4; ++e) {
-        W[0][e] = w[1][e & 1] * w[2][e >> 1];
-        W[1][e] = w[0][e & 1] * w[2][e >> 1];
-        W[2][e] = w[0][e & 1] * w[1][e >> 1];
-      }
+      const lanes::V4 W[3] = {spread4(y0, y1, 1) * spread4(z0, z1, 2),
+                              spread4(x0, x1, 1) * spread4(z0, z1, 2),
+                              spread4(x0, x1, 1) * spread4(y0, y1, 2)};
       for (int a = 0; a < 3; ++a)
-        for (int r = 0; r < 3; ++r)
-          for (int e = 0; e < 4; ++e) ts.s[a][r][e] += Vs[r][a] * W[a][e];
+        for (int r = 0; r < 3; ++r) ts.s[a][r] += Vs[r][a] * W[a];
       if (loads_ || p.f_rebar) {  // body force, loads, rebar (without, ts.b stays zero)
         Vec<D> fb = m_p * gravity_;
         if (p.f_ext) fb += p.f_ext[i];
         if (p.f_rebar) fb += p.f_rebar[i];
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 8; ++c) ts.b[r][c] += fb[r] * N[c];
+        for (int r = 0; r < 3; ++r) ts.b[r] += fb[r] * N;
       }
     }
   }
