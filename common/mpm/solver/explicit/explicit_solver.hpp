@@ -225,6 +225,25 @@ class ExplicitSolver : public SolverCore<GridT> {
                         const Vec<D>& xi, const std::int64_t* nd, int nk, const Vec<D>* a_c,
                         const Vec<D>* v_c, double* N, ChunkSums& s, std::int64_t bin_key,
                         double& leapfrog) const;
+  /// A trilinear bin's corner accelerations and velocities as vectors (x, y, z, 0).
+  struct CornerVectors {
+    lanes::V4 a[8], v[8];
+    void set(const Vec<D>* a_c, const Vec<D>* v_c) {
+      if constexpr (D == 3)
+        for (int c = 0; c < 8; ++c) {
+          a[c] = lanes::V4{a_c[c][0], a_c[c][1], a_c[c][2], 0.0};
+          if (v_c) v[c] = lanes::V4{v_c[c][0], v_c[c][1], v_c[c][2], 0.0};
+        }
+    }
+  };
+  template <G2pMode M>
+  void advance_in_cell(const ParticleView<D>& p, std::uint32_t i, std::int64_t key,
+                       const Vec<D>& xi, const CornerVectors& cv, double* N, ChunkSums& s,
+                       std::int64_t bin_key, double& leapfrog) const;
+  template <G2pMode M>
+  void update_particle(const ParticleView<D>& p, std::uint32_t i, const Vec<D>& a_p,
+                       const Vec<D>& vbar, ChunkSums& s, std::int64_t bin_key,
+                       double& leapfrog) const;
   void stress_block(const ParticleView<D>& p, PendingBlock& pb, StressScratch& scr, ChunkSums& s,
                     bool rows, bool motion) const;
   /// A particle without stress in the stress pass: a rigid one advances with its own
@@ -262,7 +281,7 @@ class ExplicitSolver : public SolverCore<GridT> {
     alignas(64) double x[3][kMax];  ///< local coordinates in the bin's cell
     alignas(64) double L[9][kMax];
     alignas(64) double v[3][kMax];
-    bool home[kMax];
+    std::int64_t home[kMax];  ///< 1 in the cell (64 bits: whole vectors of doubles)
   };
   void trilinear_sums(const ParticleView<D>& p, const Bin& bin, const Vec<D>* vg, const Vec<D>* v,
                       TrilinearBin& tb) const;

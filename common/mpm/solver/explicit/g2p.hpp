@@ -89,6 +89,10 @@ void ExplicitSolver<GridT>::gather_from_grid() {
       q_c[c].setZero();
     }
     double leapfrog = 0;  // the bin's m v(k-1/2).v(k+1/2) / 2, in a register
+    // Uniform and sparse 3D cells: the particles in the bin's cell sum the corners' values
+    // as vectors (advance_in_cell).
+    CornerVectors cv;
+    if constexpr (kTrilinear) cv.set(a_c, kMove || kPic ? v_c : nullptr);
     for (std::uint32_t i = bin.begin; i < bin.end; ++i) {
       if (rigid(i)) {
         move_rigid(i, s, bin.key);
@@ -103,8 +107,11 @@ void ExplicitSolver<GridT>::gather_from_grid() {
           if (kRemapped && !remap) strays->push_back(i);
           continue;
         }
-      advance_particle<M>(p, i, key, xi, nd, nk, home ? a_c : nullptr, home ? v_c : nullptr, N, s,
-                          bin.key, leapfrog);
+      if (kTrilinear && home)
+        advance_in_cell<M>(p, i, key, xi, cv, N, s, bin.key, leapfrog);
+      else
+        advance_particle<M>(p, i, key, xi, nd, nk, home ? a_c : nullptr, home ? v_c : nullptr, N, s,
+                            bin.key, leapfrog);
       if constexpr (kRemapped) {
         const Vec<D> mv = p.m[i] * p.v[i];
         if (home) {
@@ -146,13 +153,45 @@ void ExplicitSolver<GridT>::advance_particle(const ParticleView<D>& p, std::uint
                                              const Vec<D>* v_c, double* N, ChunkSums& s,
                                              std::int64_t bin_key, double& leapfrog) const {
   constexpr bool kMove = M == G2pMode::Move, kPic = M == G2pMode::Pic;
-  const double dt = dt_;
   grid_.values(key, xi, N);
   Vec<D> a_p = Vec<D>::Zero(), vbar = Vec<D>::Zero();
   for (int c = 0; c < nk; ++c) {
     if constexpr (!kPic) a_p += N[c] * (a_c ? a_c[c] : grid_.a[nd[c]]);
     if constexpr (kMove || kPic) vbar += N[c] * (v_c ? v_c[c] : grid_.v[nd[c]]);
   }
+  update_particle<M>(p, i, a_p, vbar, s, bin_key, leapfrog);
+}
+
+/// Uniform and sparse 3D cells: advance_particle for a particle in its bin's cell, the sums
+/// over the corners as vectors (x, y, z, 0) a corner at a time (lanes.hpp).
+template <Grid GridT>
+template <typename ExplicitSolver<GridT>::G2pMode M>
+[[gnu::always_inline]] inline void ExplicitSolver<GridT>::advance_in_cell(
+    const ParticleView<D>& p, std::uint32_t i, std::int64_t key, const Vec<D>& xi,
+    const CornerVectors& cv, double* N, ChunkSums& s, std::int64_t bin_key,
+    double& leapfrog) const {
+  if constexpr (kTrilinear) {
+    constexpr bool kMove = M == G2pMode::Move, kPic = M == G2pMode::Pic;
+    grid_.values(key, xi, N);
+    lanes::V4 a{}, v{};
+    for (int c = 0; c < 8; ++c) {
+      if constexpr (!kPic) a += N[c] * cv.a[c];
+      if constexpr (kMove || kPic) v += N[c] * cv.v[c];
+    }
+    update_particle<M>(p, i, Vec<D>(a[0], a[1], a[2]), Vec<D>(v[0], v[1], v[2]), s, bin_key,
+                       leapfrog);
+  }
+}
+
+/// Particle i's velocity (and position) from its interpolated grid acceleration a_p and
+/// velocity vbar (advance_particle's sums, or a trilinear bin's: gather_from_grid).
+template <Grid GridT>
+template <typename ExplicitSolver<GridT>::G2pMode M>
+[[gnu::always_inline]] inline void ExplicitSolver<GridT>::update_particle(
+    const ParticleView<D>& p, std::uint32_t i, const Vec<D>& a_p, const Vec<D>& vbar, ChunkSums& s,
+    std::int64_t bin_key, double& leapfrog) const {
+  constexpr bool kMove = M == G2pMode::Move, kPic = M == G2pMode::Pic;
+  const double dt = dt_;
   const Vec<D> v_old = p.v[i];
   Vec<D> v_new;
   if constexpr (kPic)

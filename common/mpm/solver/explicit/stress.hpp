@@ -117,7 +117,7 @@ void ExplicitSolver<GridT>::track_bin(const ParticleView<D>& p, const Bin& bin, 
   if constexpr (kTrilinear) {
     const int n = int(bin.end - bin.begin), nv = tb.positions(p.x + bin.begin, n);
     const BinCell bc = bin_cell(bin);
-    bool stayed[TrilinearBin::kMax];
+    std::int64_t stayed[TrilinearBin::kMax];  // (64 bits: whole vectors of doubles)
 #pragma omp simd
     for (int j = 0; j < nv; ++j) {  // (as trilinear_sums)
       bool in = true;
