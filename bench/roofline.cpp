@@ -1,6 +1,7 @@
 // The machine's own roofline: memory bandwidth (a STREAM-like triad, a = b + s c, 24 bytes an
 // element as STREAM counts them) and floating-point throughput (independent fused
-// multiply-add chains, 2 flops each), at 1 and 2 threads. Prints a table and, with --json, JSON.
+// multiply-add chains, 2 flops each), at 1 and 2 threads, and the core's clock. Prints a table
+// and, with --json, JSON.
 #include <omp.h>
 
 #include <algorithm>
@@ -65,6 +66,30 @@ double fma_gflops(int threads, long iterations, int repeats) {
   return 2.0 * kChains * kLanes * double(iterations) * threads / times[times.size() / 2] / 1e9;
 }
 
+// The core's clock while it runs: a chain of dependent integer additions retires one a cycle
+// (x86-64; 0 elsewhere). The time-stamp counter and /proc/cpuinfo give the nominal rate, not
+// the boosted one the kernels run at.
+double clock_ghz() {
+#if defined(__x86_64__)
+  std::vector<double> rates;
+  for (int r = 0; r < 5; ++r) {
+    long x = 0;
+    const long n = 200000000;
+    const double t0 = omp_get_wtime();
+    for (long i = 0; i < n; i += 10)
+      __asm__ volatile(
+          "add $1,%0\n\tadd $1,%0\n\tadd $1,%0\n\tadd $1,%0\n\tadd $1,%0\n\t"
+          "add $1,%0\n\tadd $1,%0\n\tadd $1,%0\n\tadd $1,%0\n\tadd $1,%0"
+          : "+r"(x));
+    rates.push_back(double(x) / (omp_get_wtime() - t0) / 1e9);
+  }
+  std::sort(rates.begin(), rates.end());
+  return rates[rates.size() / 2];
+#else
+  return 0.0;
+#endif
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -75,14 +100,17 @@ int main(int argc, char** argv) {
     bw[t] = triad_gbs(t, n, 9);
     fl[t] = fma_gflops(t, 4000000, 5);
   }
+  const double ghz = clock_ghz();
   if (json) {
     std::printf(
-        "{\"triad_GBs\": {\"1\": %.2f, \"2\": %.2f}, \"fma_GFLOPs\": {\"1\": %.2f, \"2\": %.2f}}\n",
-        bw[1], bw[2], fl[1], fl[2]);
+        "{\"triad_GBs\": {\"1\": %.2f, \"2\": %.2f}, \"fma_GFLOPs\": {\"1\": %.2f, \"2\": %.2f}, "
+        "\"clock_GHz\": %.3f}\n",
+        bw[1], bw[2], fl[1], fl[2], ghz);
   } else {
     std::printf("%-8s %16s %16s %12s\n", "threads", "triad GB/s", "FMA GFLOP/s", "ridge flop/B");
     for (int t = 1; t <= 2; ++t)
       std::printf("%-8d %16.2f %16.2f %12.2f\n", t, bw[t], fl[t], fl[t] / bw[t]);
+    std::printf("core clock %.3f GHz (dependent additions)\n", ghz);
   }
   return 0;
 }
