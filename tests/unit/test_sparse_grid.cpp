@@ -2,6 +2,10 @@
 // corners of those cells are nodes; its keys follow the dense window's cell order.
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <random>
 #include <set>
 
 #include "mpm/grid/grid.hpp"
@@ -116,6 +120,56 @@ TEST(SparseGrid, FaceNodesAreTheActiveOnes) {
   EXPECT_EQ(g.fixed_nodes().size(), 2u * 16u);  // a 4 x 4 patch of nodes under each
   EXPECT_TRUE(g.slip_nodes().empty());
   for (const auto& f : g.fixed_nodes()) EXPECT_EQ(f.face, 4);
+}
+
+// The trilinear kernels ask "is x still in its bin's cell c?" as c <= (x - origin) / h < c + 1
+// (CellLattice::in_cell) instead of locating it: the answer and the local coordinates must be
+// locate's exactly, bit for bit, at random points and at points one rounding step either side of
+// cell faces, where a fused multiply-add or a different order would show.
+TEST(CellLattice, InCellIsLocateBitForBit) {
+  Lattice lat = lattice3(60, 0.38e-3);  // Taylor-bar cells, an origin off the lattice of h
+  lat.origin = Vec3(-5.43e-3, -5.41e-3, 1.7e-4);
+  const UniformGrid<3> g(lat, BoundarySpec{});
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int points = 0, faces = 0, out = 0;
+  auto check = [&](const Vec3& x) {
+    IVec<3> cell;
+    Vec3 xi_loc;
+    g.CellLattice<3>::locate(x, cell, xi_loc);
+    for (int dc = -1; dc <= 1; ++dc) {  // its own cell, and the neighbours along x
+      const double c[3] = {double(cell[0] + dc), double(cell[1]), double(cell[2])};
+      Vec3 xi;
+      const bool in = g.in_cell(c, x, xi);
+      EXPECT_EQ(in, dc == 0) << "x = " << x.transpose() << ", cell offset " << dc;
+      if (dc == 0)
+        for (int a = 0; a < 3; ++a)
+          EXPECT_EQ(std::bit_cast<std::uint64_t>(xi[a]), std::bit_cast<std::uint64_t>(xi_loc[a]));
+      out += !in;
+    }
+    ++points;
+  };
+  for (int k = 0; k < 20000; ++k) {
+    Vec3 x;
+    for (int a = 0; a < 3; ++a) x[a] = lat.origin[a] + lat.h * (1.0 + 58.0 * u(rng));
+    check(x);
+    // One and two rounding steps either side of the face below x along each axis.
+    for (int a = 0; a < 3; ++a) {
+      const double face = lat.origin[a] + lat.h * std::floor((x[a] - lat.origin[a]) / lat.h);
+      Vec3 y = x;
+      for (double p : {std::nextafter(std::nextafter(face, -1.0), -1.0), std::nextafter(face, -1.0),
+                       face, std::nextafter(face, 1.0)}) {
+        y[a] = p;
+        check(y);
+        ++faces;
+      }
+    }
+  }
+  EXPECT_EQ(points, 20000 + faces);
+  EXPECT_EQ(out, 2 * points);  // each point in exactly one of the three cells tried
+  const double nan_c[3] = {1, 1, 1};
+  Vec3 xi;
+  EXPECT_FALSE(g.in_cell(nan_c, Vec3(std::nan(""), 0, 0), xi));
 }
 
 }  // namespace

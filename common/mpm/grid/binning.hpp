@@ -25,7 +25,7 @@ struct Bin {
   std::int64_t key = -1;             ///< cell key (= index of the cell's lower corner node)
   /// The cell's global index along each axis, on grids of square cells counted from the
   /// domain's origin (CellLattice): a particle is in the cell when c <= (x - origin) / h < c + 1
-  /// (ExplicitSolver::in_bin_cell); unused elsewhere.
+  /// (CellLattice::in_cell); unused elsewhere.
   std::array<double, 3> cell{};
 };
 

@@ -210,6 +210,21 @@ class CellLattice {
       xi[a] = r[a] - f;
     }
   }
+  /// Whether x lies in the global cell c (its indices as doubles), and its local coordinates
+  /// there. locate's r = (x - origin) / h has floor(r) = c exactly when c <= r < c + 1, and then
+  /// its xi = r - floor(r) is r - c: the same answer and the same xi as locate, without the
+  /// floor and the conversion (false for NaN). (r is compared, so it is rounded before r - c:
+  /// no fused multiply-add there.) The trilinear kernels write it out in plain doubles for
+  /// their vector loops (ExplicitSolver::bin_cell).
+  [[gnu::always_inline]] bool in_cell(const double* c, const Vec<D>& x, Vec<D>& xi) const {
+    bool in = true;
+    for (int a = 0; a < D; ++a) {
+      const double r = (x[a] - origin_[a]) * inv_h_;
+      in = in & (r >= c[a]) & (r < c[a] + 1.0);
+      xi[a] = r - c[a];
+    }
+    return in;
+  }
   /// True when a global cell lies inside the domain.
   bool in_domain(const IVec<D>& cell) const {
     for (int a = 0; a < D; ++a)

@@ -150,22 +150,14 @@ class ExplicitSolver : public SolverCore<GridT> {
     grid_.locate(x, key, xi);
   }
   /// Uniform and sparse 3D cells: whether x lies in the bin's cell, and its local coordinates
-  /// there. locate's r = (x - origin) / h has floor(r) = c exactly when c <= r < c + 1, and
-  /// then its xi = r - floor(r) is r - c: the same answer and the same xi without the floor,
-  /// the conversion and the key (false for NaN); a vector of particles at a time where the
-  /// caller loops over a bin (trilinear_sums, track_bin). (r is compared, so it is rounded
-  /// before r - c: no fused multiply-add there.)
+  /// there (CellLattice::in_cell: the same answer and xi as locate).
   [[gnu::always_inline]] bool in_bin_cell(const Bin& bin, const Vec<D>& x, Vec<D>& xi) const {
-    bool in = kTrilinear;
     if constexpr (kTrilinear)
-      for (int a = 0; a < D; ++a) {
-        const double r = (x[a] - grid_.origin()[a]) * grid_.inv_h(), c = bin.cell[std::size_t(a)];
-        in = in & (r >= c) & (r < c + 1.0);
-        xi[a] = r - c;
-      }
-    return in;
+      return grid_.in_cell(bin.cell.data(), x, xi);
+    else
+      return false;
   }
-  /// in_bin_cell's constants for loops over a bin in plain doubles.
+  /// in_cell's constants for loops over a bin in plain doubles.
   struct BinCell {
     double o[3], ih, c[3];
   };

@@ -201,8 +201,8 @@ void ExplicitSolver<GridT>::trilinear_sums(const ParticleView<D>& p, const Bin& 
     // Whole vectors over positions one axis an array: a bin holds about 8 particles, and the
     // compiler's vector loop over the particles' interleaved coordinates wants more than a
     // vector's worth (the rest ran scalar). Lanes past the bin repeat its first particle.
-    // (in_bin_cell's test and xi, in plain doubles: the compiler vectorises no Eigen vector
-    // built in the loop.)
+    // (CellLattice::in_cell's test and xi, in plain doubles: the compiler vectorises no Eigen
+    // vector built in the loop.)
     const int n = int(bin.end - bin.begin), nv = tb.positions(p.x + bin.begin, n);
     const BinCell bc = bin_cell(bin);
 #pragma omp simd
