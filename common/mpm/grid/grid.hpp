@@ -215,7 +215,7 @@ class CellLattice {
   /// its xi = r - floor(r) is r - c: the same answer and the same xi as locate, without the
   /// floor and the conversion (false for NaN). (r is compared, so it is rounded before r - c:
   /// no fused multiply-add there.) The trilinear kernels write it out in plain doubles for
-  /// their vector loops (ExplicitSolver::bin_cell).
+  /// their vector loops (ExplicitSolver::cell_lanes).
   [[gnu::always_inline]] bool in_cell(const double* c, const Vec<D>& x, Vec<D>& xi) const {
     bool in = true;
     for (int a = 0; a < D; ++a) {

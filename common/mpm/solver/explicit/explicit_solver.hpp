@@ -149,31 +149,11 @@ class ExplicitSolver : public SolverCore<GridT> {
     }
     grid_.locate(x, key, xi);
   }
-  /// Uniform and sparse 3D cells: whether x lies in the bin's cell, and its local coordinates
-  /// there (CellLattice::in_cell: the same answer and xi as locate).
-  [[gnu::always_inline]] bool in_bin_cell(const Bin& bin, const Vec<D>& x, Vec<D>& xi) const {
-    if constexpr (kTrilinear)
-      return grid_.in_cell(bin.cell.data(), x, xi);
-    else
-      return false;
-  }
-  /// in_cell's constants for loops over a bin in plain doubles.
-  struct BinCell {
-    double o[3], ih, c[3];
-  };
-  BinCell bin_cell(const Bin& bin) const {
-    BinCell b{};
-    if constexpr (kTrilinear) {
-      b.ih = grid_.inv_h();
-      for (int a = 0; a < 3; ++a) b.o[a] = grid_.origin()[a], b.c[a] = bin.cell[std::size_t(a)];
-    }
-    return b;
-  }
   /// A particle of a bin: its cell and local coordinates (the bin's, when it is still there).
   [[gnu::always_inline]] void locate_in_bin(const Bin& bin, const Vec<D>& x, std::int64_t& key,
                                             Vec<D>& xi) const {
     if constexpr (kTrilinear) {
-      if (in_bin_cell(bin, x, xi)) {
+      if (grid_.in_cell(bin.cell.data(), x, xi)) {  // the same answer and xi as locate
         key = bin.key;
         return;
       }
@@ -262,14 +242,6 @@ class ExplicitSolver : public SolverCore<GridT> {
     static constexpr int kLanes = 8;  ///< AVX-512's doubles (twice AVX2's): kMax's divisor
     /// Lanes a bin's loops run: n rounded up to whole vectors.
     static int lanes(int n) { return (n + kLanes - 1) / kLanes * kLanes; }
-    /// Copies n positions into x one axis an array, the lanes up to whole vectors with the
-    /// first; returns the lanes.
-    int positions(const Vec<3>* xp, int n) {
-      const int nv = lanes(n);
-      for (int j = 0; j < nv; ++j)
-        for (int a = 0; a < 3; ++a) x[a][j] = xp[j < n ? j : 0][a];
-      return nv;
-    }
     alignas(64) double x[3][kMax];  ///< local coordinates in the bin's cell
     alignas(64) double L[9][kMax];
     alignas(64) double v[3][kMax];
@@ -277,6 +249,8 @@ class ExplicitSolver : public SolverCore<GridT> {
   };
   void trilinear_sums(const ParticleView<D>& p, const Bin& bin, const Vec<D>* vg, const Vec<D>* v,
                       TrilinearBin& tb) const;
+  template <bool Xi>
+  int cell_lanes(const ParticleView<D>& p, const Bin& bin, TrilinearBin& tb) const;
   void track_bin(const ParticleView<D>& p, const Bin& bin, TrilinearBin& tb, ChunkSums& s) const;
   /// p2g's sums over a bin's particles in its cell (p2g.hpp): mass and momentum and body force
   /// by corner, the stress by axis, component and edge along the axis.

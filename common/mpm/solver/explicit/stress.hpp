@@ -107,6 +107,41 @@ template <bool C>
   stress_block(p, pb, scr, s, rows, move);
 }
 
+/// Uniform and sparse 3D cells: the bin's particles' local coordinates in its cell (tb.x) and
+/// whether they are still there (tb.home), whole vectors at a time; returns the particles.
+/// Without Xi (the move's tracking) only whether.
+/// Positions go one axis an array first: a bin holds about 8 particles, and the compiler's
+/// vector loop over the particles' interleaved coordinates wanted more than a vector's worth
+/// (the rest ran scalar). Lanes past the bin repeat its first particle. The test and xi are
+/// CellLattice::in_cell's, in plain doubles (the compiler vectorises no Eigen vector built in
+/// the loop).
+template <Grid GridT>
+template <bool Xi>
+[[gnu::always_inline]] inline int ExplicitSolver<GridT>::cell_lanes(const ParticleView<D>& p,
+                                                                    const Bin& bin,
+                                                                    TrilinearBin& tb) const {
+  const int n = int(bin.end - bin.begin), nv = TrilinearBin::lanes(n);
+  if constexpr (kTrilinear) {
+    const Vec<D>* x = p.x + bin.begin;
+    for (int j = 0; j < nv; ++j)
+      for (int a = 0; a < 3; ++a) tb.x[a][j] = x[j < n ? j : 0][a];
+    double o[3], c[3];
+    for (int a = 0; a < 3; ++a) o[a] = grid_.origin()[a], c[a] = bin.cell[std::size_t(a)];
+    const double ih = grid_.inv_h();
+#pragma omp simd
+    for (int j = 0; j < nv; ++j) {
+      bool in = true;
+      for (int a = 0; a < 3; ++a) {
+        const double r = (tb.x[a][j] - o[a]) * ih;
+        in = in & (r >= c[a]) & (r < c[a] + 1.0);
+        if constexpr (Xi) tb.x[a][j] = r - c[a];
+      }
+      tb.home[j] = in;
+    }
+  }
+  return n;
+}
+
 /// Uniform and sparse 3D cells, after the move: a vector pass over the bin finds the particles
 /// still in its cell (finite, in the domain and the window, in the bin: nothing to book), and
 /// only the others go through track_move. Rigid particles and rebar nodes were tracked as they
@@ -115,21 +150,10 @@ template <Grid GridT>
 void ExplicitSolver<GridT>::track_bin(const ParticleView<D>& p, const Bin& bin, TrilinearBin& tb,
                                       ChunkSums& s) const {
   if constexpr (kTrilinear) {
-    const int n = int(bin.end - bin.begin), nv = tb.positions(p.x + bin.begin, n);
-    const BinCell bc = bin_cell(bin);
-    std::int64_t stayed[TrilinearBin::kMax];  // (64 bits: whole vectors of doubles)
-#pragma omp simd
-    for (int j = 0; j < nv; ++j) {  // (as trilinear_sums)
-      bool in = true;
-      for (int a = 0; a < 3; ++a) {
-        const double r = (tb.x[a][j] - bc.o[a]) * bc.ih;
-        in = in & (r >= bc.c[a]) & (r < bc.c[a] + 1.0);
-      }
-      stayed[j] = in;
-    }
+    const int n = cell_lanes<false>(p, bin, tb);  // (the bin's sums are used: tb is free)
     for (int j = 0; j < n; ++j)
       if (const std::uint32_t i = bin.begin + std::uint32_t(j);
-          !stayed[j] && p.material[i] < kRebarNode)
+          !tb.home[j] && p.material[i] < kRebarNode)
         track_move(p.x[i], i, bin.key, s);
   }
 }
@@ -198,23 +222,7 @@ void ExplicitSolver<GridT>::trilinear_sums(const ParticleView<D>& p, const Bin& 
                                            const Vec<D>* vg, const Vec<D>* v,
                                            TrilinearBin& tb) const {
   if constexpr (kTrilinear) {
-    // Whole vectors over positions one axis an array: a bin holds about 8 particles, and the
-    // compiler's vector loop over the particles' interleaved coordinates wants more than a
-    // vector's worth (the rest ran scalar). Lanes past the bin repeat its first particle.
-    // (CellLattice::in_cell's test and xi, in plain doubles: the compiler vectorises no Eigen
-    // vector built in the loop.)
-    const int n = int(bin.end - bin.begin), nv = tb.positions(p.x + bin.begin, n);
-    const BinCell bc = bin_cell(bin);
-#pragma omp simd
-    for (int j = 0; j < nv; ++j) {
-      bool in = true;
-      for (int a = 0; a < 3; ++a) {
-        const double r = (tb.x[a][j] - bc.o[a]) * bc.ih;
-        in = in & (r >= bc.c[a]) & (r < bc.c[a] + 1.0);
-        tb.x[a][j] = r - bc.c[a];
-      }
-      tb.home[j] = in;
-    }
+    const int nv = TrilinearBin::lanes(cell_lanes<true>(p, bin, tb));
     // Corner c = bx + 2 by + 4 bz. Differences across x on the edges e = by + 2 bz, across y
     // on e = bx + 2 bz, across z on e = bx + 2 by.
     double dx[3][4], dy[3][4], dz[3][4];
