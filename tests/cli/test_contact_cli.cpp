@@ -67,6 +67,14 @@ TEST(ContactCli, BadContactInputExitsTwoNamingFileLineAndKey) {
        "[[contact]]\nbodies = [\"block\", \"lid\"]\ngap = 0\n",
        "gap",
        {"contact.0.gap", "> 0"}},
+      {"separation.toml",
+       "[[contact]]\nbodies = [\"block\", \"lid\"]\nseparation = -0.1\n",
+       "separation",
+       {"contact.0.separation", ">= 0"}},
+      {"both.toml",
+       "[[contact]]\nbodies = [\"block\", \"lid\"]\ngap = 0.8\nseparation = 0.125\n",
+       "separation",
+       {"contact.0.separation", "not both"}},
       {"twice.toml",
        "[[contact]]\nbodies = [\"lid\", \"block\"]\n\n[[contact]]\nbodies = [\"block\", "
        "\"lid\"]\nfriction = 0.3\n",
@@ -96,6 +104,9 @@ TEST(ContactCli, BadContactInputExitsTwoNamingFileLineAndKey) {
                     " --set contact.0.friction=0.2 --set contact.0.normal=lid"
                     " --set contact.0.gap=0.8 -o /dev/null",
                 dir)
+                .status,
+            0);
+  EXPECT_EQ(run(prep + " " + good.string() + " --set contact.0.separation=0.125 -o /dev/null", dir)
                 .status,
             0);
   r = run(prep + " " + good.string() + " --set contact.0.friction=-1 -o /dev/null", dir);

@@ -452,12 +452,19 @@ void read_contacts(Reader& top, Scene& s) {
     const Origin o = doc.origin(e, array_origin);
     const auto* t = e.as_table();
     if (!t) throw InputError(doc.where(o, path), "expected a table ([[contact]]), " + got(e));
-    Reader r(doc, *t, path, o, {"bodies", "friction", "normal", "gap"});
+    Reader r(doc, *t, path, o, {"bodies", "friction", "normal", "gap", "separation"});
     ContactSpec c;
     c.loc = r.loc();
     std::tie(c.body_a, c.body_b) = read_contact_bodies(r, s);
     c.friction = r.number("friction", Bound::NonNegative).value_or(0.0);
     c.gap = r.number("gap", Bound::Positive).value_or(c.gap);
+    if (r.has("separation")) {
+      if (r.has("gap"))
+        r.fail("separation",
+               "expected `gap` (mass centres) or `separation` (surfaces), not both: they are two "
+               "ways of deciding where the bodies touch");
+      c.separation = *r.number("separation", Bound::NonNegative);
+    }
     if (const auto normal = r.string("normal")) {
       const std::string &a = s.bodies[c.body_a].name, &b = s.bodies[c.body_b].name;
       if (*normal == "steeper")

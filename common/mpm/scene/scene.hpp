@@ -192,6 +192,11 @@ struct ContactSpec {
   /// finest cell's size, along the normal (undeformed touching bodies with two particles a
   /// cell per axis: 0.70 to 0.98).
   double gap = 1.5;
+  /// When >= 0 (the scene's `separation`), the fields touch at a node when their surfaces
+  /// there, estimated from the mass centres and the shares of the node's volume
+  /// (touching_gap, contact_fields.hpp), are closer than this, in the finest cell's size;
+  /// `gap` is then not used.
+  double separation = -1;
   SourceLoc loc;  ///< key "contact.<index>"
 };
 

@@ -34,7 +34,11 @@
 //   impulse reaches them too.
 // The gap check: two fields touch at a node when their centres there, sum_p m_p N_i x_p / m_i,
 // are closer than the pair's `gap` (1.5 of the finest cell by default) along n; without it
-// bodies a cell apart would already push on each other (Huang et al. 2011).
+// bodies a cell apart would already push on each other (Huang et al. 2011). Touching bodies
+// put those centres 2/3 to 1 cell apart, by how they share the node (touching_gap), so one
+// number either misses some touching nodes or lets bodies apart push. With `separation` the
+// pair compares the centres' distance with the touching one for the fields' shares of the
+// node's volume, sum_p V_p N_i: the estimated distance of the surfaces.
 #include <omp.h>
 
 #include <algorithm>
@@ -55,10 +59,12 @@ void ExplicitSolver<GridT>::exchange_momentum(Exchange on) {
   Vec<D>* a_f[kMaxF];
   const Vec<D>* g_f[kMaxF];
   const Vec<D>* x_f[kMaxF];
+  const double* V_f[kMaxF];
   m_f[0] = grid_.m.data();
   v_f[0] = on == Exchange::Remap ? grid_.v_remap.data() : grid_.v.data();
   a_f[0] = grid_.a.data();
   g_f[0] = x_f[0] = nullptr;  // the common field only ever sticks
+  V_f[0] = nullptr;
   for (int f = 1; f < F; ++f) {
     auto& fd = contact_.field(f);
     m_f[f] = fd.m.data();
@@ -66,6 +72,7 @@ void ExplicitSolver<GridT>::exchange_momentum(Exchange on) {
     a_f[f] = fd.a.data();
     g_f[f] = fd.g.data();
     x_f[f] = fd.x.data();
+    V_f[f] = fd.V.data();
   }
   const double cell = grid_.min_cell_size();
   const bool update = on == Exchange::Update;  // accelerations and forces follow
@@ -123,7 +130,14 @@ void ExplicitSolver<GridT>::exchange_momentum(Exchange on) {
             } else {
               if (w_n <= 0) continue;  // separating: free
               const Vec<D> gap = x_f[b][i] / mb - x_f[a][i] / ma;
-              if (gap.dot(nrm) > contact_.touch(a, b) * cell) continue;  // apart: free
+              const double sep = contact_.separation(a, b);
+              if (sep < 0) {
+                if (gap.dot(nrm) > contact_.touch(a, b) * cell) continue;  // apart: free
+              } else {
+                const double Va = V_f[a][i], Vb = V_f[b][i];
+                const double touching = touching_gap(Va / (Va + Vb));
+                if (gap.dot(nrm) > (touching + sep) * cell) continue;  // apart: free
+              }
               if (decide && s < 64) state |= std::uint64_t(1) << s;
             }
             const Vec<D> J_n = -m_ab * w_n * nrm;
