@@ -462,7 +462,8 @@ void read_contacts(Reader& top, Scene& s) {
       if (r.has("gap"))
         r.fail("separation",
                "expected `gap` (mass centres) or `separation` (surfaces), not both: they are two "
-               "ways of deciding where the bodies touch");
+               "ways of deciding where the bodies touch (to try `separation` on a scene that "
+               "sets `gap`, take the `gap` line out)");
       c.separation = *r.number("separation", Bound::NonNegative);
     }
     if (const auto normal = r.string("normal")) {
