@@ -376,6 +376,7 @@ std::vector<typename GradedGrid<D>::Level> GradedGrid<D>::number_nodes(
     nl.cell.assign(std::size_t(s), -1);
   }
   node_ijk_.clear();
+  node_level_.clear();
   for (std::size_t key = 0; key < cells_.size(); ++key) {
     Cell& cell = cells_[key];
     const int sh = L - cell.level;
@@ -387,8 +388,10 @@ std::vector<typename GradedGrid<D>::Level> GradedGrid<D>::number_nodes(
       if (*s < 0) {
         *s = std::int32_t(node_ijk_.size());
         node_ijk_.push_back(P);
+        node_level_.push_back(cell.level);
       }
       cell.corner[c] = *s;
+      node_level_[*s] = std::min(node_level_[*s], cell.level);
     }
   }
   return nodes_of;
@@ -417,6 +420,7 @@ bool GradedGrid<D>::add_optional_nodes(const std::vector<IVec<D>>& cpos,
       cell.mask |= 1u << (k - kCorners<D>);
       optional_.push_back(*s);
       hanging_[*s] = 1;
+      node_level_[*s] = std::min(node_level_[*s], cell.level);
     }
     if (cell.mask == 0) continue;
     auto [it, fresh] = mask_min.try_emplace(cell.mask, 0.0);

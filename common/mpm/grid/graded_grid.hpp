@@ -151,6 +151,10 @@ class GradedGrid {
   /// since the time step must hold for the finest cells (004, section 3.4).
   double cell_size(std::int64_t) const { return level_[levels_].h; }
   double min_cell_size() const { return level_[levels_].h; }
+  /// The size of the largest cell a node's shape function spans (m): its level's cells inside
+  /// a level, the coarser cells' on a level interface (hanging nodes included). What a
+  /// distance measured at the node compares with, e.g. contact's gap.
+  double node_cell_size(std::int64_t n) const { return level_[node_level_[n]].h; }
 
   // Levels -----------------------------------------------------------------------------------
   int levels() const { return levels_; }
@@ -352,6 +356,7 @@ class GradedGrid {
   std::vector<std::int32_t> optional_;
   std::vector<IVec<D>> node_ijk_;  ///< node positions in finest cells from the origin
   std::vector<std::uint8_t> hanging_;
+  std::vector<std::uint8_t> node_level_;  ///< level of the coarsest cell using the node
   std::vector<FaceNode> fixed_, slip_;
 };
 

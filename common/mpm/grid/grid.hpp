@@ -233,6 +233,7 @@ class CellLattice {
   }
   double cell_size(std::int64_t) const { return h_; }
   double min_cell_size() const { return h_; }
+  double node_cell_size(std::int64_t) const { return h_; }
   /// Shape functions and gradients (1/m) at local coordinates xi of a cell.
   void shape(std::int64_t, const Vec<D>& xi, double* N, Vec<D>* G) const {
     shape_functions<D>(xi, inv_h_, N, G);
@@ -285,6 +286,7 @@ concept Grid = requires(G& g, const G& cg, const Vec<G::kDim>* xs, std::size_t n
   { cg.layers() } -> std::same_as<int>;
   { cg.cell_size(key) } -> std::same_as<double>;
   { cg.min_cell_size() } -> std::same_as<double>;
+  { cg.node_cell_size(key) } -> std::same_as<double>;
   // Node data (GridNodes), cleared for a step, and the nodes on constrained domain faces.
   { cg.nodes() } -> std::same_as<std::size_t>;
   { g.m } -> std::same_as<std::vector<double>&>;

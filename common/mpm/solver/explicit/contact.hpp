@@ -33,12 +33,15 @@
 //   The particles' accelerations are taken against the corrected velocities, so that
 //   impulse reaches them too.
 // The gap check: two fields touch at a node when their centres there, sum_p m_p N_i x_p / m_i,
-// are closer than the pair's `gap` (1.5 of the finest cell by default) along n; without it
+// are closer than the pair's `gap` (1.5 cells by default) along n; without it
 // bodies a cell apart would already push on each other (Huang et al. 2011). Touching bodies
 // put those centres 2/3 to 1 cell apart, by how they share the node (touching_gap), so one
 // number either misses some touching nodes or lets bodies apart push. With `separation` the
 // pair compares the centres' distance with the touching one for the fields' shares of the
-// node's volume, sum_p V_p N_i: the estimated distance of the surfaces.
+// node's volume, sum_p V_p N_i: the estimated distance of the surfaces. Both count in cells of
+// the node (GradedGrid::node_cell_size: the largest cell its shape function spans), since the
+// centres of touching bodies lie that node's cells apart; in the finest level's cells a
+// coarser level's touching nodes went free and bodies passed each other there.
 #include <omp.h>
 
 #include <algorithm>
@@ -74,7 +77,6 @@ void ExplicitSolver<GridT>::exchange_momentum(Exchange on) {
     x_f[f] = fd.x.data();
     V_f[f] = fd.V.data();
   }
-  const double cell = grid_.min_cell_size();
   const bool update = on == Exchange::Update;  // accelerations and forces follow
   // The step's first exchange decides which pairs touch at each node, the second follows.
   const bool decide = on == Exchange::Velocity || (update && scheme_ != Scheme::USF);
@@ -131,6 +133,7 @@ void ExplicitSolver<GridT>::exchange_momentum(Exchange on) {
               if (w_n <= 0) continue;  // separating: free
               const Vec<D> gap = x_f[b][i] / mb - x_f[a][i] / ma;
               const double sep = contact_.separation(a, b);
+              const double cell = grid_.node_cell_size(i);
               if (sep < 0) {
                 if (gap.dot(nrm) > contact_.touch(a, b) * cell) continue;  // apart: free
               } else {
