@@ -2,7 +2,9 @@
 # V5 study: the four striking speeds of 004 Table 5 at the level-1 cell CELL (level 2 half of
 # it), and 749 m/s at each cell of CELLS (the resolution study), one run after the other; the
 # residual velocity (mpm-post residual), steps, wall time and throughput (mpm-run --stats) of
-# each go to study/table.md (table.py).
+# each go to study/table.md (table.py), with the change of each speed's residual velocity from
+# one cell to the next finer one that ran (the convergence check: `make converge` runs the four
+# speeds at 6 mm into the same folder).
 # Usage: ./study.sh BUILD_DIR THREADS "434 606 749 1058" CELL "16mm 10mm 8mm"
 set -euo pipefail
 cd "$(dirname "$0")"
@@ -16,11 +18,19 @@ for c in $cells; do
   [ "$c" = "$cell" ] && [[ " $speeds " == *" 749 "* ]] && continue
   cases+=("$c:749")
 done
+# The level-2 box on the lattice of a level-1 cell of C mm: the scene's 80 mm x 80 mm quarter
+# region, widened to whole cells (84 mm at 6 mm), over the whole height of the domain (from
+# z = -400 mm, the whole cells up to 160 mm: 158 mm at 6 mm). The same box at 16, 10 and 8 mm.
+level_box() {
+  awk -v c="${1%mm}" 'BEGIN { x = c * int((80 + c - 1e-9) / c); z = -400 + c * int(560 / c + 1e-9);
+    printf "%g %g %g mm", x, x, z }'
+}
 for cv in "${cases[@]}"; do
   c=${cv%%:*} v=${cv##*:}
   name=c${c%mm}_$v
   echo "running $name ($(date +%H:%M:%S)) ..." >&2
   "$bin/mpm-prep/mpm-prep" scene.toml --set grid.cell_size="$c" \
+    --set "grid.levels.0.max=$(level_box "$c")" \
     --set "bodies.projectile.velocity=0 0 -$v m/s" --set "solver.end_time=$(end_time "$v")" \
     --set "scene.title=V5 $v m/s, level 1 $c" -o study/$name.model 2> study/prep_$name.log
   status=0
