@@ -96,23 +96,6 @@ max = "22 2 mm"
 )";
 
 template <class Solver>
-BarsRun run_bars(const Scene& scene, Solver& solver, ColumnStore& cols);
-
-BarsRun run_bars(std::vector<std::string> overrides, bool graded = false) {
-  if (graded) overrides.push_back("grid.domain.max=24 3 mm");
-  const Scene scene = parse_scene(graded ? kBarsGraded : std::string(kBars), "bars", "", overrides);
-  const Lattice lat = make_lattice(scene);
-  std::vector<BodyReport> report;
-  ColumnStore cols = voxelise(scene, lat, report);
-  if (graded) {
-    GradedSolver<2> solver(scene, GradedGrid<2>(lat, scene), cols);
-    return run_bars(scene, solver, cols);
-  }
-  UniformSolver<2> solver(scene, UniformGrid<2>(lat, scene.boundary), cols);
-  return run_bars(scene, solver, cols);
-}
-
-template <class Solver>
 BarsRun run_bars(const Scene& scene, Solver& solver, ColumnStore& cols) {
   BarsRun r;
   r.p_a0 = body_state(cols, 0).p;
@@ -131,6 +114,20 @@ BarsRun run_bars(const Scene& scene, Solver& solver, ColumnStore& cols) {
   r.F_end = solver.contact_force()[0][0];
   r.E_end = solver.balance().leapfrog_total;
   return r;
+}
+
+BarsRun run_bars(std::vector<std::string> overrides, bool graded = false) {
+  if (graded) overrides.push_back("grid.domain.max=24 3 mm");
+  const Scene scene = parse_scene(graded ? kBarsGraded : std::string(kBars), "bars", "", overrides);
+  const Lattice lat = make_lattice(scene);
+  std::vector<BodyReport> report;
+  ColumnStore cols = voxelise(scene, lat, report);
+  if (graded) {
+    GradedSolver<2> solver(scene, GradedGrid<2>(lat, scene), cols);
+    return run_bars(scene, solver, cols);
+  }
+  UniformSolver<2> solver(scene, UniformGrid<2>(lat, scene.boundary), cols);
+  return run_bars(scene, solver, cols);
 }
 
 TEST(Contact, TheGapSetsHowCloseBodiesComeBeforeTheyPush) {

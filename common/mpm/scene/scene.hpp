@@ -188,13 +188,13 @@ struct ContactSpec {
   /// their difference (an average), or one body's (body_a or body_b: a smooth, hard
   /// penetrator's surface against a damaged target's ragged one).
   enum class Normal { Steeper, Average, BodyA, BodyB } normal = Normal::Steeper;
-  /// The fields touch at a node when their mass centres there are closer than this, in the
-  /// finest cell's size, along the normal (undeformed touching bodies with two particles a
-  /// cell per axis: 0.70 to 0.98).
+  /// The fields touch at a node when their mass centres there are closer than this, in cells
+  /// of the node (Grid::node_cell_size), along the normal (undeformed touching bodies with two
+  /// particles a cell per axis: 0.70 to 0.98).
   double gap = 1.5;
   /// When >= 0 (the scene's `separation`), the fields touch at a node when their surfaces
   /// there, estimated from the mass centres and the shares of the node's volume
-  /// (touching_gap, contact_fields.hpp), are closer than this, in the finest cell's size;
+  /// (touching_gap, contact_fields.hpp), are closer than this, in cells of the node;
   /// `gap` is then not used.
   double separation = -1;
   SourceLoc loc;  ///< key "contact.<index>"

@@ -132,8 +132,6 @@ class ContactFields {
   double touch(int a, int b) const { return gap_[a * field_count() + b]; }
   /// The pair's `separation` (cells), or negative where the pair uses `gap`.
   double separation(int a, int b) const { return separation_[a * field_count() + b]; }
-  /// True when some pair decides by surfaces: the fields then sum their nodal volumes.
-  bool surfaces() const { return surfaces_; }
 
   /// Sizes every field to `nodes` nodes and zeroes mass, momentum, force and mass gradient
   /// (and the remapped momentum when `remap`).
