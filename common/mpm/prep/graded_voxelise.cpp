@@ -42,11 +42,19 @@ GradedModel prepare(const Scene& scene, const Lattice& lattice, std::vector<Body
     };
     std::vector<BodyReport> rep;
     parts.push_back(voxelise(scene, lat, rep, cells));
+    // A body's spacings: those of the coarsest and of the finest level it fills.
+    for (std::size_t b = 0; b < rep.size(); ++b)
+      rep[b].spacing = rep[b].finest_spacing =
+          rep[b].particles > 0 ? scene.bodies[b].spacing(lat.h) : 0.0;
     out.particles[l] = parts.back().size();
     if (report.empty()) {
       report = rep;
     } else {
       for (std::size_t b = 0; b < rep.size(); ++b) {
+        if (rep[b].particles > 0) {
+          if (report[b].spacing == 0) report[b].spacing = rep[b].spacing;
+          report[b].finest_spacing = rep[b].finest_spacing;
+        }
         report[b].particles += rep[b].particles;
         report[b].mass += rep[b].mass;
         report[b].skipped_overlap += rep[b].skipped_overlap;

@@ -192,7 +192,7 @@ int mirror_images(const Scene& scene, const Lattice& lattice, const Vec3& lo, co
 /// body's exact mass (a half model's plate is not 50% short).
 std::size_t print_bodies(const Scene& scene, const std::vector<BodyReport>& report,
                          const Lattice& lattice, const BodyBoxes& boxes) {
-  std::fprintf(stderr, "  %-14s %-12s %12s %10s %14s %14s %8s\n", "body", "material", "particles",
+  std::fprintf(stderr, "  %-14s %-12s %12s %13s %14s %14s %8s\n", "body", "material", "particles",
                "spacing", "mass kg", "exact kg", "error");
   std::size_t total = 0;
   bool mirrored = false;
@@ -206,10 +206,14 @@ std::size_t print_bodies(const Scene& scene, const std::vector<BodyReport>& repo
     const double mass = r.mass * images;
     const std::string name = images > 1 ? r.name + " (x" + std::to_string(images) + ")" : r.name;
     mirrored = mirrored || images > 1;
+    // On a graded grid a body filling finer levels has their spacings too: coarsest / finest.
+    const std::string spacing = r.finest_spacing > 0 && r.finest_spacing < 0.999 * r.spacing
+                                    ? mm(r.spacing) + " / " + mm(r.finest_spacing)
+                                    : mm(r.spacing);
     std::fprintf(
-        stderr, "  %-14s %-12s %12zu %7s mm %14.6g %14.6g %7.2f%%\n", name.c_str(),
+        stderr, "  %-14s %-12s %12zu %13s mm %14.6g %14.6g %7.2f%%\n", name.c_str(),
         scene.bodies[b].rigid ? "(rigid)" : scene.materials[scene.bodies[b].material].name.c_str(),
-        r.particles, mm(r.spacing).c_str(), mass, r.exact_mass,
+        r.particles, spacing.c_str(), mass, r.exact_mass,
         r.exact_mass > 0 ? 100.0 * (mass - r.exact_mass) / r.exact_mass : 0.0);
   }
   std::fprintf(stderr, "  %-14s %-12s %12zu\n", "total", "", total);

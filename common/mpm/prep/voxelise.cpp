@@ -441,6 +441,7 @@ BodyReport report_body(const BodyPlan& P, const Scene& scene, std::size_t b, con
   const double density = density_of(scene, scene.bodies[b]);
   rep.exact_mass = density * (scene.axisymmetric ? region.revolved_volume() : region.volume());
   rep.spacing = P.spacing;
+  rep.finest_spacing = P.spacing;
   rep.skipped_overlap = P.skipped;
   return rep;
 }

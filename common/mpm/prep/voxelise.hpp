@@ -23,6 +23,7 @@ struct BodyReport {
   double mass = 0;                  ///< sum of particle masses, kg (per metre of thickness in 2D)
   double exact_mass = 0;            ///< density x exact volume, kg
   double spacing = 0;               ///< particle spacing (h / n, or particle_spacing), m
+  double finest_spacing = 0;        ///< on a graded grid, that of the finest level it fills, m
   std::size_t skipped_overlap = 0;  ///< points inside an earlier body, not created again
 };
 
