@@ -39,6 +39,8 @@ TEST(GradedCli, PipelineWritesTheGridAndSplits) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("graded grid:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("level 2: cell 0.5 mm"), std::string::npos) << r.err;
+  // The block fills both levels: the table gives both spacings (half of each level's cell).
+  EXPECT_NE(r.err.find("0.5 / 0.25 mm"), std::string::npos) << r.err;
   r = run(runner + " " + (dir / "model.mpm").string() + " -o " + (dir / "run.mpm").string() +
               " --stats --progress none",
           dir);
