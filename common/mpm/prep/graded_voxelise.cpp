@@ -42,10 +42,10 @@ GradedModel prepare(const Scene& scene, const Lattice& lattice, std::vector<Body
     };
     std::vector<BodyReport> rep;
     parts.push_back(voxelise(scene, lat, rep, cells));
-    // A body's spacings: those of the coarsest and of the finest level it fills.
-    for (std::size_t b = 0; b < rep.size(); ++b)
-      rep[b].spacing = rep[b].finest_spacing =
-          rep[b].particles > 0 ? scene.bodies[b].spacing(lat.h) : 0.0;
+    // A body's spacings: those of the coarsest and of the finest level it fills (voxelise
+    // reports this level's; a level the body does not fill gives none).
+    for (BodyReport& r : rep)
+      if (r.particles == 0) r.spacing = r.finest_spacing = 0;
     out.particles[l] = parts.back().size();
     if (report.empty()) {
       report = rep;
