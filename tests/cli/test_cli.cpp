@@ -237,6 +237,47 @@ TEST(Cli, PrepWarnsOfAnAbsurdStepCount) {
   EXPECT_NE(r.err.find("explicit steps"), std::string::npos) << r.err;
 }
 
+// mpm-prep says where the particles put a body's flat faces. The block's particles sit at
+// (k + 1/2) 0.5 mm from the domain's corner (two a 1 mm cell), so their volumes fill whole
+// 0.5 mm slabs: a face at z = 0.3 mm is filled from 0.5 mm (0.2 mm short of it), one at 4.3 mm
+// to 4.5 mm (0.2 mm beyond it); faces on those planes (the base block's, its x and y faces)
+// are filled exactly and not listed, nor are a sphere's or a cylinder's sides (no flat face).
+TEST(Cli, PrepSaysWhereTheParticlesPutTheFaces) {
+  const auto dir = temp_dir("faces");
+  const std::string out = " -o " + (dir / "m.mpm").string();
+  Result r = run(prep + " " + kBlock.string() + out, dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("faces between"), std::string::npos) << r.err;
+  r = run(prep + " " + kBlock.string() + " --set \"bodies.block.translate=0 0 2.3 mm\"" + out, dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("block: face z = 0.3 mm filled to 0.5 mm (0.2 mm short of it; particles "
+                       "0.5 mm apart)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("block: face z = 4.3 mm filled to 4.5 mm (0.2 mm beyond it"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("face x"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("face y"), std::string::npos) << r.err;
+  // A cylinder along z from 0.3 to 3.6 mm (its ends flat: 0.5 and 3.5 mm) and a sphere.
+  const fs::path two =
+      variant(dir, "round.toml", "shape = \"box\"\nsize = \"4 4 4 mm\"\ntranslate = \"0 0 2 mm\"",
+              "shape = \"cylinder\"\nradius = \"1.3 mm\"\nlength = \"3.3 mm\"\n"
+              "translate = \"-2 -2 0.3 mm\"\n"
+              "[[bodies]]\nname = \"ball\"\nmaterial = \"steel\"\n"
+              "shape = \"sphere\"\nradius = \"1.3 mm\"\n"
+              "translate = \"2 2 4.1 mm\"");
+  r = run(prep + " " + two.string() + out, dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("block: face z = 0.3 mm filled to 0.5 mm"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("block: face z = 3.6 mm filled to 3.5 mm (0.1 mm short of it"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("face x"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("face y"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("ball: face"), std::string::npos) << r.err;
+}
+
 // Nothing the user made is lost: no tool writes its output over its own input, by any name
 // (a link, a relative path); the input stays byte for byte as it was, and the error is an
 // input error (status 2). An -o that is a directory is an input error too, except for

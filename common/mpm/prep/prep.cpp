@@ -15,6 +15,7 @@
 #include "mpm/grid/lattice.hpp"
 #include "mpm/grid/sparse_grid.hpp"
 #include "mpm/prep/checks.hpp"
+#include "mpm/prep/face_offsets.hpp"
 #include "mpm/prep/graded_voxelise.hpp"
 #include "mpm/prep/initial_fields.hpp"
 #include "mpm/prep/rebar.hpp"
@@ -224,6 +225,15 @@ std::size_t print_bodies(const Scene& scene, const std::vector<BodyReport>& repo
   return total;
 }
 
+/// The bodies' flat faces that the particles' lattice moves (face_offsets.hpp).
+void print_face_offsets(const Scene& scene, const std::vector<FaceOffset>& faces) {
+  if (faces.empty()) return;
+  std::fprintf(stderr,
+               "  faces between the particles' lattice planes, filled to the nearest one (a "
+               "domain corner a whole number of particle spacings from a face puts it on one):\n");
+  for (const FaceOffset& f : faces) std::fprintf(stderr, "    %s\n", describe(scene, f).c_str());
+}
+
 /// Each material's wave speed and the step it alone would allow on the finest cells: a
 /// modulus or a density in the wrong unit shows here.
 void print_materials(const Scene& scene, double h_min) {
@@ -397,7 +407,8 @@ int prepare_model(const PrepOptions& opt) {
   if (!scene.grid.levels.empty()) graded = prepare_graded(scene, lattice, report);
   ColumnStore cols =
       graded ? std::move(graded->columns) : voxelise(scene, lattice, report, progress_cells(scene));
-  apply_initial_fields(scene, cols);      // spin, velocity and stress fields
+  apply_initial_fields(scene, cols);  // spin, velocity and stress fields
+  const std::vector<FaceOffset> faces = face_offsets(scene, lattice, cols);  // before rebar nodes
   std::vector<RebarReport> rebar_report;  // truss elements, nodes after the bodies' particles
   ColumnStore rebar = discretise_rebar(scene, lattice, boxes.lo, boxes.hi, cols, rebar_report);
   const GradedModel* graded_grid = graded ? &*graded : nullptr;
@@ -407,6 +418,7 @@ int prepare_model(const PrepOptions& opt) {
   if (!opt.quiet) {
     print_grid(scene, lattice, graded_grid);
     const std::size_t total = print_bodies(scene, report, lattice, boxes);
+    print_face_offsets(scene, faces);
     if (!rebar_report.empty()) print_rebar(scene, rebar_report);
     print_materials(scene, graded_grid ? graded_grid->h_min : lattice.h);
     print_estimates(scene, estimates, total);

@@ -1,0 +1,41 @@
+#pragma once
+/// Private to prep: where the particles put a body's flat faces. Particles sit on a lattice of
+/// their spacing s from the cell corners, so a flat face between two of its planes is filled
+/// to the nearest one: the model's body ends up to s / 2 off the scene's. For a perforation
+/// that moves the struck face toward or away from the projectile (V5 at 6 mm cells, the
+/// slab's front face 0.5 mm proud of z = 0: the residual velocity at 434 m/s 9% lower than
+/// with the face on a node plane; examples/rc-slab/results.md, 2026-11-27).
+#include <string>
+#include <vector>
+
+#include "mpm/core/columns.hpp"
+#include "mpm/grid/lattice.hpp"
+#include "mpm/scene/scene.hpp"
+
+namespace mpm {
+
+/// A flat face of a body's bounding box and where its particles fill it to.
+struct FaceOffset {
+  std::size_t body = 0;
+  int axis = 0;        ///< 0, 1, 2: x, y, z
+  bool upper = false;  ///< the face at the box's maximum along axis (else its minimum)
+  double face = 0;     ///< the scene's face, m
+  double filled = 0;   ///< the particles' extent there (centre +- half their spacing), m
+  double spacing = 0;  ///< the spacing of the particle that reaches furthest, m
+};
+
+/// The flat faces of the primitive bodies (not meshes) that lie inside the domain and that
+/// the particles fill to more than 1% of their spacing off the face. A face of the bounding box
+/// is flat when a quarter or more of a 16 x 16 sample of it, just inside, is in the body (a
+/// box's faces, a cylinder's ends; not a sphere's or an ogive's tip). Bodies' spacing from their
+/// particles' volume m / rho (2D: per metre; axisymmetric: per radian, m / (rho r)). `cols`
+/// holds the bodies' particles only (before rebar nodes are appended: their "spacing" would be
+/// their element's).
+std::vector<FaceOffset> face_offsets(const Scene& scene, const Lattice& lattice,
+                                     const ColumnStore& cols);
+
+/// The summary's line for one offset ("slab: face z = 0 mm filled to 0.5 mm (0.5 mm beyond
+/// it; particles 1.5 mm apart)").
+std::string describe(const Scene& scene, const FaceOffset& f);
+
+}  // namespace mpm
