@@ -64,6 +64,32 @@ TEST(GradedCli, PipelineWritesTheGridAndSplits) {
   EXPECT_TRUE(fs::exists(dir / "model_vtk" / "frame_grid_0000.vtu"));
 }
 
+// Each level fills a face on its own lattice: the block (z from 0.3 to 4.3 mm) stands half in
+// a level-2 box of 0.5 mm cells (x < 0, z < 2 mm), whose particles (0.25 mm apart, from z = 0)
+// fill its bottom from 0.25 mm, and half in level 1 (1 mm cells, 0.5 mm apart), which fills
+// it from 0.5 mm. mpm-prep lists both, and the top (level 1 only) filled to 4.5 mm.
+TEST(GradedCli, PrepSaysWhereEachLevelPutsAFace) {
+  const auto dir = temp_dir("graded_faces");
+  const fs::path scene =
+      graded_block(dir, "\n[[grid.levels]]\nlevel = 2\nmin = \"-3 -3 0 mm\"\nmax = \"0 3 2 mm\"\n");
+  Result r = run(prep + " " + scene.string() + " --set \"bodies.block.translate=0 0 2.3 mm\" -o " +
+                     (dir / "model.mpm").string(),
+                 dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("block: face z = 0.3 mm filled to 0.5 mm (0.2 mm short of it; particles "
+                       "0.5 mm apart)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("block: face z = 0.3 mm filled to 0.25 mm (0.05 mm beyond it; particles "
+                       "0.25 mm apart)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("block: face z = 4.3 mm filled to 4.5 mm (0.2 mm beyond it; particles "
+                       "0.5 mm apart)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("face z = 4.3 mm filled to 4.25"), std::string::npos) << r.err;
+}
 TEST(GradedCli, ProfileAlongALine) {
   const auto dir = temp_dir("graded_profile");
   const fs::path scene = graded_block(dir, kLevel);

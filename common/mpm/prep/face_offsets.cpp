@@ -50,10 +50,14 @@ std::vector<FaceOffset> face_offsets(const Scene& scene, const Lattice& lattice,
   const double* rho = cols.get<double>("rho");
   if (!body_col || !x || !m || !rho || n == 0) return out;
   const BodyIds body(body_col);
-  // Each body's particles' extent (centre -+ half the spacing) and the spacing at the extremes.
+  // Each body's particles' extent (centre -+ half the spacing), for each spacing it has: the
+  // levels of a graded grid fill a face each on its own lattice.
+  struct Extent {
+    double s;
+    std::array<double, 3> lo, hi;
+  };
   constexpr double inf = std::numeric_limits<double>::infinity();
-  std::vector<std::array<double, 3>> lo(nb, {inf, inf, inf}), hi(nb, {-inf, -inf, -inf});
-  std::vector<std::array<double, 3>> s_lo(nb, {0, 0, 0}), s_hi(nb, {0, 0, 0});
+  std::vector<std::vector<Extent>> ext(nb);
   for (std::size_t i = 0; i < n; ++i) {
     const int b = body[i];
     if (b < 0 || std::size_t(b) >= nb || !(m[i] > 0) || !(rho[i] > 0)) continue;
@@ -65,21 +69,24 @@ std::vector<FaceOffset> face_offsets(const Scene& scene, const Lattice& lattice,
       s = xi[0] > 0 ? std::sqrt(m[i] / (rho[i] * xi[0])) : 0.0;
     else
       s = std::sqrt(m[i] / rho[i]);
+    if (!(s > 0)) continue;
+    auto g = std::find_if(ext[b].begin(), ext[b].end(),
+                          [s](const Extent& e) { return std::abs(e.s - s) <= 1e-6 * s; });
+    if (g == ext[b].end()) {
+      ext[b].push_back({s, {inf, inf, inf}, {-inf, -inf, -inf}});
+      g = ext[b].end() - 1;
+    }
     for (int a = 0; a < dim; ++a) {
-      if (xi[a] - 0.5 * s < lo[b][a]) {
-        lo[b][a] = xi[a] - 0.5 * s;
-        s_lo[b][a] = s;
-      }
-      if (xi[a] + 0.5 * s > hi[b][a]) {
-        hi[b][a] = xi[a] + 0.5 * s;
-        s_hi[b][a] = s;
-      }
+      g->lo[a] = std::min(g->lo[a], xi[a] - 0.5 * s);
+      g->hi[a] = std::max(g->hi[a], xi[a] + 0.5 * s);
     }
   }
   const double tol = 1e-9 * lattice.h;
   for (std::size_t b = 0; b < nb; ++b) {
     const BodySpec& spec = scene.bodies[b];
-    if (spec.shape == ShapeKind::Mesh || !std::isfinite(lo[b][0])) continue;
+    if (spec.shape == ShapeKind::Mesh || ext[b].empty()) continue;
+    std::sort(ext[b].begin(), ext[b].end(),
+              [](const Extent& p, const Extent& q) { return p.s > q.s; });  // coarsest first
     const std::unique_ptr<Region> region = make_region(spec, scene);
     Vec3 box_lo, box_hi;
     region->bounds(box_lo, box_hi);
@@ -90,10 +97,14 @@ std::vector<FaceOffset> face_offsets(const Scene& scene, const Lattice& lattice,
         // out of the domain) is not the body's.
         if (face < lattice.origin[a] - tol || face > lattice.max()[a] + tol) continue;
         if (!flat_face(*region, box_lo, box_hi, a, upper, dim)) continue;
-        const double filled = upper ? hi[b][a] : lo[b][a];
-        const double s = upper ? s_hi[b][a] : s_lo[b][a];
-        if (std::abs(filled - face) <= 0.01 * s) continue;
-        out.push_back({b, a, upper, face, filled, s});
+        for (const Extent& e : ext[b]) {
+          const double filled = upper ? e.hi[a] : e.lo[a];
+          const double off = std::abs(filled - face);
+          // Particles of this spacing that do not reach the face (a level away from it) fill
+          // it nowhere; those that do are within half their spacing of it.
+          if (off <= 0.01 * e.s || off > 0.5 * e.s * (1 + 1e-6)) continue;
+          out.push_back({b, a, upper, face, filled, e.s});
+        }
       }
   }
   return out;

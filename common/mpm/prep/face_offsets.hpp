@@ -25,12 +25,13 @@ struct FaceOffset {
 };
 
 /// The flat faces of the primitive bodies (not meshes) that lie inside the domain and that
-/// the particles fill to more than 1% of their spacing off the face. A face of the bounding box
-/// is flat when a quarter or more of a 16 x 16 sample of it, just inside, is in the body (a
-/// box's faces, a cylinder's ends; not a sphere's or an ogive's tip). Bodies' spacing from their
-/// particles' volume m / rho (2D: per metre; axisymmetric: per radian, m / (rho r)). `cols`
-/// holds the bodies' particles only (before rebar nodes are appended: their "spacing" would be
-/// their element's).
+/// the particles fill to more than 1% of their spacing off the face, one entry for each
+/// particle spacing that reaches the face (each level of a graded grid has its own lattice). A face
+/// of the bounding box is flat when a quarter or more of a 16 x 16 sample of it, just inside, is in
+/// the body (a box's faces, a cylinder's ends; not a sphere's or an ogive's tip). Bodies' spacing
+/// from their particles' volume m / rho (2D: per metre; axisymmetric: per radian, m / (rho r)).
+/// `cols` holds the bodies' particles only (before rebar nodes are appended: their "spacing" would
+/// be their element's).
 std::vector<FaceOffset> face_offsets(const Scene& scene, const Lattice& lattice,
                                      const ColumnStore& cols);
 
