@@ -2,9 +2,11 @@
 #include "mpm/prep/face_offsets.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 
 #include "mpm/prep/region.hpp"
 #include "mpm/scene/particles.hpp"
