@@ -90,6 +90,7 @@ TEST(GradedCli, PrepSaysWhereEachLevelPutsAFace) {
       << r.err;
   EXPECT_EQ(r.err.find("face z = 4.3 mm filled to 4.25"), std::string::npos) << r.err;
 }
+
 TEST(GradedCli, ProfileAlongALine) {
   const auto dir = temp_dir("graded_profile");
   const fs::path scene = graded_block(dir, kLevel);

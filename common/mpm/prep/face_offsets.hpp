@@ -1,10 +1,10 @@
 #pragma once
 /// Private to prep: where the particles put a body's flat faces. Particles sit on a lattice of
 /// their spacing s from the cell corners, so a flat face between two of its planes is filled
-/// to the nearest one: the model's body ends up to s / 2 off the scene's. For a perforation
-/// that moves the struck face toward or away from the projectile (V5 at 6 mm cells, the
-/// slab's front face 0.5 mm proud of z = 0: the residual velocity at 434 m/s 9% lower than
-/// with the face on a node plane; examples/rc-slab/results.md, 2026-11-27).
+/// to the nearest one: the model's body ends up to s / 2 off the scene's (V5 at 6 / 3 mm cells
+/// with the floor at -400 mm: the slab's struck face 1 mm low in level 1 and 0.5 mm proud in
+/// level 2; examples/rc-slab/results.md, 2026-11-27). A face's place against the node planes,
+/// which can matter as much, is not reported where the particles fill the face exactly.
 #include <string>
 #include <vector>
 
@@ -21,7 +21,7 @@ struct FaceOffset {
   bool upper = false;  ///< the face at the box's maximum along axis (else its minimum)
   double face = 0;     ///< the scene's face, m
   double filled = 0;   ///< the particles' extent there (centre +- half their spacing), m
-  double spacing = 0;  ///< the spacing of the particle that reaches furthest, m
+  double spacing = 0;  ///< the spacing of the particles that fill it (one level's), m
 };
 
 /// The flat faces of the primitive bodies (not meshes) that lie inside the domain and that
