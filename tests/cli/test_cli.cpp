@@ -248,8 +248,37 @@ TEST(Cli, PrepSaysWhereTheParticlesPutTheFaces) {
   Result r = run(prep + " " + kBlock.string() + out, dir);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err.find("faces between"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("faces inside a cell"), std::string::npos) << r.err;  // all on node planes
+  // Moved by half a cell: the particles still fill it exactly (their planes are 0.5 mm apart),
+  // but its bottom and top lie midway between node planes.
+  r = run(prep + " " + kBlock.string() + " --set \"bodies.block.translate=0 0 2.5 mm\"" + out, dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("faces between"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("block: face z = 0.5 mm lies 0.5 mm above the node plane z = 0 mm (0.5 of "
+                       "the 1 mm cells)"),
+            std::string::npos)
+      << r.err;
+  // Its top faces nothing (the domain's top is free): not listed. With a second body above it,
+  // it is (the second body's faces lie on node planes).
+  EXPECT_EQ(r.err.find("block: face z = 4.5 mm lies"), std::string::npos) << r.err;
+  const fs::path capped =
+      variant(dir, "capped.toml", "particles_per_cell = 2\n",
+              "particles_per_cell = 2\n\n[[bodies]]\nname = \"cap\"\nmaterial = \"steel\"\n"
+              "shape = \"box\"\nsize = \"2 2 1 mm\"\ntranslate = \"0 0 6.5 mm\"\n");
+  r = run(prep + " " + capped.string() + " --set \"bodies.block.translate=0 0 2.5 mm\"" + out, dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("block: face z = 4.5 mm lies 0.5 mm above the node plane z = 4 mm (0.5 of "
+                       "the 1 mm cells)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("cap: face"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("face x"), std::string::npos) << r.err;  // the block's sides face nothing
   r = run(prep + " " + kBlock.string() + " --set \"bodies.block.translate=0 0 2.3 mm\"" + out, dir);
   ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("block: face z = 0.3 mm lies 0.3 mm above the node plane z = 0 mm (0.3 of "
+                       "the 1 mm cells)"),
+            std::string::npos)
+      << r.err;
   EXPECT_NE(r.err.find("block: face z = 0.3 mm filled to 0.5 mm (0.2 mm short of it; particles "
                        "0.5 mm apart)"),
             std::string::npos)

@@ -89,6 +89,17 @@ TEST(GradedCli, PrepSaysWhereEachLevelPutsAFace) {
             std::string::npos)
       << r.err;
   EXPECT_EQ(r.err.find("face z = 4.3 mm filled to 4.25"), std::string::npos) << r.err;
+  // Its bottom's place against each level's node planes, 0.3 mm above z = 0 in both levels (0.3
+  // of level 1's cells, 0.6 of level 2's): it faces the wall z = 0. The top faces nothing.
+  EXPECT_NE(r.err.find("block: face z = 0.3 mm lies 0.3 mm above the node plane z = 0 mm (0.3 of "
+                       "level 1's 1 mm cells)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("block: face z = 0.3 mm lies 0.3 mm above the node plane z = 0 mm (0.6 of "
+                       "level 2's 0.5 mm cells)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("face z = 4.3 mm lies"), std::string::npos) << r.err;
 }
 
 TEST(GradedCli, ProfileAlongALine) {

@@ -10,6 +10,7 @@
 
 #include "mpm/core/columns.hpp"
 #include "mpm/grid/lattice.hpp"
+#include "mpm/prep/checks.hpp"
 #include "mpm/scene/scene.hpp"
 
 namespace mpm {
@@ -35,8 +36,33 @@ struct FaceOffset {
 std::vector<FaceOffset> face_offsets(const Scene& scene, const Lattice& lattice,
                                      const ColumnStore& cols);
 
+/// A flat face of a body's bounding box that lies inside the cells of a level it meets (not on
+/// one of the level's node planes).
+struct FacePlace {
+  std::size_t body = 0;
+  int axis = 0;      ///< 0, 1, 2: x, y, z
+  double face = 0;   ///< the scene's face, m
+  int level = 1;     ///< the grid level whose cells hold (part of) the face; 1: uniform grids
+  double h = 0;      ///< that level's cell size, m
+  double below = 0;  ///< the level's node plane just below the face along axis, m
+};
+
+/// The flat faces (as face_offsets finds them) of the primitive bodies that face something a
+/// body can strike, and that lie more than 1% of a cell off the node planes of a level holding
+/// part of them, one entry for each such level (the finest level at each of a 16 x 16 sample of
+/// the face, just inside the body and the domain). A face faces another body whose bounding box
+/// (`boxes`, body_boxes in checks.hpp) reaches beyond it and overlaps it across, or a domain
+/// side beyond it that is a wall (slip or fixed). Node planes of level l lie at the domain's
+/// corner plus whole multiples of cell_size / 2^(l - 1).
+std::vector<FacePlace> face_places(const Scene& scene, const Lattice& lattice,
+                                   const BodyBoxes& boxes);
+
 /// The summary's line for one offset ("slab: face z = 0 mm filled to 0.5 mm (0.5 mm beyond
 /// it; particles 1.5 mm apart)").
 std::string describe(const Scene& scene, const FaceOffset& f);
+
+/// The summary's line for one place ("slab: face z = 0 mm lies 2 mm above the node plane
+/// z = -2 mm (0.5 of level 2's 4 mm cells)"; `graded` false: "(0.3 of the 1 mm cells)").
+std::string describe(const Scene& scene, const FacePlace& f, bool graded);
 
 }  // namespace mpm

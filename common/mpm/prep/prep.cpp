@@ -234,6 +234,17 @@ void print_face_offsets(const Scene& scene, const std::vector<FaceOffset>& faces
   for (const FaceOffset& f : faces) std::fprintf(stderr, "    %s\n", describe(scene, f).c_str());
 }
 
+/// The bodies' flat faces that lie inside a cell, not on a node plane (face_offsets.hpp).
+void print_face_places(const Scene& scene, const std::vector<FacePlace>& places) {
+  if (places.empty()) return;
+  std::fprintf(stderr,
+               "  faces inside a cell (where a body meets an impact, its face's place against the "
+               "node planes can move the result: docs/scene.md, \"Where the faces fall\"):\n");
+  const bool graded = !scene.grid.levels.empty();
+  for (const FacePlace& f : places)
+    std::fprintf(stderr, "    %s\n", describe(scene, f, graded).c_str());
+}
+
 /// Each material's wave speed and the step it alone would allow on the finest cells: a
 /// modulus or a density in the wrong unit shows here.
 void print_materials(const Scene& scene, double h_min) {
@@ -419,6 +430,7 @@ int prepare_model(const PrepOptions& opt) {
     print_grid(scene, lattice, graded_grid);
     const std::size_t total = print_bodies(scene, report, lattice, boxes);
     print_face_offsets(scene, faces);
+    print_face_places(scene, face_places(scene, lattice, boxes));
     if (!rebar_report.empty()) print_rebar(scene, rebar_report);
     print_materials(scene, graded_grid ? graded_grid->h_min : lattice.h);
     print_estimates(scene, estimates, total);
