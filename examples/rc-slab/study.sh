@@ -5,10 +5,14 @@
 # each go to study/table.md (table.py), with the change of each speed's residual velocity from
 # one cell to the next finer one that ran (the convergence check: `make converge` runs the four
 # speeds at 6 mm into the same folder).
-# Usage: ./study.sh BUILD_DIR THREADS "434 606 749 1058" CELL "16mm 10mm 8mm"
+# PLACE=mid (a sixth argument; `make placement`) lowers the domain's floor by half a level-2 cell,
+# so that the slab's struck face lies midway between level 2's node planes instead of on one:
+# cases c<cell>_<v>_mid, and table.md gives each speed's change between the two placements.
+# Usage: ./study.sh BUILD_DIR THREADS "434 606 749 1058" CELL "16mm 10mm 8mm" [node|mid]
 set -euo pipefail
 cd "$(dirname "$0")"
-bin=$1 threads=$2 speeds=$3 cell=$4 cells=$5
+bin=$1 threads=$2 speeds=$3 cell=$4 cells=$5 place=${6:-node}
+case $place in node) suffix= ;; mid) suffix=_mid ;; *) echo "study.sh: PLACE is node or mid, not '$place'" >&2; exit 2 ;; esac
 mkdir -p study
 # 004 Table 5's end times.
 end_time() { case $1 in 434) echo 2ms ;; 606) echo 0.6ms ;; 749) echo 0.5ms ;; 1058) echo 0.3ms ;; *) echo 0.5ms ;; esac; }
@@ -24,20 +28,24 @@ done
 # morning). The level-2 box on that lattice: the scene's 80 mm x 80 mm quarter region widened to
 # whole cells (84 mm at 6 mm), over the whole height of the domain (the whole cells up to 160 mm:
 # 156 mm at 6 mm). At 16, 10, 8 and 5 mm the floor is -400 mm and the box the scene's.
-floor_z() { awk -v c="${1%mm}" 'BEGIN { printf "%g", -c * int(400 / c + 1 - 1e-9) }'; }
+# PLACE=mid: a quarter of the level-1 cell lower (half a level-2 cell).
+floor_z() {
+  awk -v c="${1%mm}" -v mid="$([ "$place" = mid ] && echo 1 || echo 0)" \
+    'BEGIN { printf "%g", -c * int(400 / c + 1 - 1e-9) - mid * c / 4 }'
+}
 level_box() {
   awk -v c="${1%mm}" -v f="$(floor_z "$1")" 'BEGIN { x = c * int((80 + c - 1e-9) / c);
     z = f + c * int((160 - f) / c + 1e-9); printf "%g %g %g mm", x, x, z }'
 }
 for cv in "${cases[@]}"; do
   c=${cv%%:*} v=${cv##*:}
-  name=c${c%mm}_$v
+  name=c${c%mm}_$v$suffix
   echo "running $name ($(date +%H:%M:%S)) ..." >&2
   "$bin/mpm-prep/mpm-prep" scene.toml --set grid.cell_size="$c" \
     --set "grid.domain.min=0 0 $(floor_z "$c") mm" --set "grid.levels.0.min=0 0 $(floor_z "$c") mm" \
     --set "grid.levels.0.max=$(level_box "$c")" \
     --set "bodies.projectile.velocity=0 0 -$v m/s" --set "solver.end_time=$(end_time "$v")" \
-    --set "scene.title=V5 $v m/s, level 1 $c" -o study/$name.model 2> study/prep_$name.log
+    --set "scene.title=V5 $v m/s, level 1 $c${suffix:+, struck face mid-cell}" -o study/$name.model 2> study/prep_$name.log
   status=0
   "$bin/mpm-run/mpm-run" study/$name.model -o study/$name.mpm --threads "$threads" --stats \
     --progress none 2> study/run_$name.log || status=$?

@@ -114,6 +114,34 @@ def main():
             "| v0 | cells (mm) | v_r (m/s) | change | under 3% |",
             "|---|---|---|---|---|",
         ] + pairs + [""]
+    # Placement (make placement): each speed with the struck face midway between level 2's node
+    # planes against the same cell with it on a node plane.
+    places = []
+    for path in sorted(glob.glob(os.path.join(study, "residual_c*_*_mid.json"))):
+        m = re.match(r"residual_c([0-9.]+)_(\d+)_mid\.json$", os.path.basename(path))
+        if not m:
+            continue
+        cell, v = m.group(1), int(m.group(2))
+        mid, node = read_case(study, f"c{cell}_{v}_mid"), read_case(study, f"c{cell}_{v}")
+        if not mid or mid.get("vr") is None or v not in EXPERIMENT:
+            continue
+        vm = mid["vr"]
+        err = f"{100 * (vm - EXPERIMENT[v]) / EXPERIMENT[v]:+.1f}%"
+        if node and node.get("vr") is not None:
+            places.append((v, float(cell), f"| {v} | {cell} | {node['vr']:.1f} | {vm:.1f} "
+                           f"| {100 * (vm - node['vr']) / node['vr']:+.1f}% | {err} |"))
+        else:
+            places.append((v, float(cell), f"| {v} | {cell} | - | {vm:.1f} | | {err} |"))
+    if places:
+        lines += [
+            "Placement (`make placement`): the slab's struck face midway between level 2's node "
+            "planes (the floor half a level-2 cell lower) against it on a node plane, same cells:",
+            "",
+            "| v0 | cell (mm) | v_r, face on a node plane | v_r, face mid-cell | change "
+            "| mid-cell against exp |",
+            "|---|---|---|---|---|---|",
+        ] + [row for _, _, row in sorted(places)] + [""]
+        rows += len(places)
     open(os.path.join(study, "table.md"), "w").write("\n".join(lines) + "\n")
     if not rows:
         sys.exit("table.py: no finished case in " + study)
