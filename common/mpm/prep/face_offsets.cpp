@@ -143,11 +143,11 @@ std::vector<FaceOffset> face_offsets(const Scene& scene, const Lattice& lattice,
       g->hi[a] = std::max(g->hi[a], xi[a] + 0.5 * s);
     }
   }
+  for (std::vector<Extent>& e : ext)  // coarsest first
+    std::sort(e.begin(), e.end(), [](const Extent& p, const Extent& q) { return p.s > q.s; });
   for_each_flat_face(
       scene, lattice,
       [&](std::size_t b, const Region&, const Vec3&, const Vec3&, int a, bool upper, double face) {
-        std::sort(ext[b].begin(), ext[b].end(),
-                  [](const Extent& p, const Extent& q) { return p.s > q.s; });  // coarsest first
         for (const Extent& e : ext[b]) {
           const double filled = upper ? e.hi[a] : e.lo[a];
           const double off = std::abs(filled - face);
@@ -185,7 +185,7 @@ std::vector<FacePlace> face_places(const Scene& scene, const Lattice& lattice,
           double face) {
         if (!faces_something(b, lo, hi, a, upper, face)) return;
         for (const int l : levels_holding(scene, region, lo, hi, a, upper, dmin, dmax)) {
-          const double h = lattice.h / double(1 << (l - 1));
+          const double h = std::ldexp(lattice.h, 1 - l);
           const double r = (face - lattice.origin[a]) / h;
           const double frac = r - std::floor(r);
           if (frac <= 0.01 || frac >= 0.99) continue;  // on a node plane, to 1% of a cell
@@ -195,10 +195,10 @@ std::vector<FacePlace> face_places(const Scene& scene, const Lattice& lattice,
   return out;
 }
 
-std::string describe(const Scene& scene, const FacePlace& f, bool graded) {
-  const char* axis = f.axis == 0 ? "x" : f.axis == 1 ? "y" : "z";
+std::string describe(const Scene& scene, const FacePlace& f) {
+  const char* axis = axis_name(f.axis);
   char cells[64];
-  if (graded)
+  if (!scene.grid.levels.empty())
     std::snprintf(cells, sizeof cells, "level %d's %.4g mm cells", f.level, f.h * 1e3);
   else
     std::snprintf(cells, sizeof cells, "the %.4g mm cells", f.h * 1e3);
@@ -211,7 +211,7 @@ std::string describe(const Scene& scene, const FacePlace& f, bool graded) {
 }
 
 std::string describe(const Scene& scene, const FaceOffset& f) {
-  const char* axis = f.axis == 0 ? "x" : f.axis == 1 ? "y" : "z";
+  const char* axis = axis_name(f.axis);
   const double off = f.filled - f.face;
   const bool beyond = f.upper ? off > 0 : off < 0;  // the model's body reaches past the face
   char text[300];

@@ -3,8 +3,9 @@
 /// their spacing s from the cell corners, so a flat face between two of its planes is filled
 /// to the nearest one: the model's body ends up to s / 2 off the scene's (V5 at 6 / 3 mm cells
 /// with the floor at -400 mm: the slab's struck face 1 mm low in level 1 and 0.5 mm proud in
-/// level 2; examples/rc-slab/results.md, 2026-11-27). A face's place against the node planes,
-/// which can matter as much, is not reported where the particles fill the face exactly.
+/// level 2; examples/rc-slab/results.md, 2026-11-27). A face's place against the node planes can
+/// matter as much, whether or not the particles fill it exactly (V5 at 434 m/s: 8% between its
+/// struck face on a node plane and midway between two): face_places lists the faces inside a cell.
 #include <string>
 #include <vector>
 
@@ -62,7 +63,7 @@ std::vector<FacePlace> face_places(const Scene& scene, const Lattice& lattice,
 std::string describe(const Scene& scene, const FaceOffset& f);
 
 /// The summary's line for one place ("slab: face z = 0 mm lies 2 mm above the node plane
-/// z = -2 mm (0.5 of level 2's 4 mm cells)"; `graded` false: "(0.3 of the 1 mm cells)").
-std::string describe(const Scene& scene, const FacePlace& f, bool graded);
+/// z = -2 mm (0.5 of level 2's 4 mm cells)"; on a uniform grid "(0.3 of the 1 mm cells)").
+std::string describe(const Scene& scene, const FacePlace& f);
 
 }  // namespace mpm

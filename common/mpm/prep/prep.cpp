@@ -240,9 +240,7 @@ void print_face_places(const Scene& scene, const std::vector<FacePlace>& places)
   std::fprintf(stderr,
                "  faces inside a cell (where a body meets an impact, its face's place against the "
                "node planes can move the result: docs/scene.md, \"Where the faces fall\"):\n");
-  const bool graded = !scene.grid.levels.empty();
-  for (const FacePlace& f : places)
-    std::fprintf(stderr, "    %s\n", describe(scene, f, graded).c_str());
+  for (const FacePlace& f : places) std::fprintf(stderr, "    %s\n", describe(scene, f).c_str());
 }
 
 /// Each material's wave speed and the step it alone would allow on the finest cells: a
