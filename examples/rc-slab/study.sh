@@ -8,11 +8,20 @@
 # PLACE=mid (a sixth argument; `make placement`) lowers the domain's floor by half a level-2 cell,
 # so that the slab's struck face lies midway between level 2's node planes instead of on one:
 # cases c<cell>_<v>_mid, and table.md gives each speed's change between the two placements.
-# Usage: ./study.sh BUILD_DIR THREADS "434 606 749 1058" CELL "16mm 10mm 8mm" [node|mid]
+# rate (`make tension`): the concrete's tensile strength rises with the strain rate
+# (materials.concrete.strength.tension_rate = "malvar-ross", docs/scene.md): cases
+# c<cell>_<v>_rate, and table.md gives each speed's change from HJC as published.
+# Usage: ./study.sh BUILD_DIR THREADS "434 606 749 1058" CELL "16mm 10mm 8mm" [node|mid|rate]
 set -euo pipefail
 cd "$(dirname "$0")"
 bin=$1 threads=$2 speeds=$3 cell=$4 cells=$5 place=${6:-node}
-case $place in node) suffix= ;; mid) suffix=_mid ;; *) echo "study.sh: PLACE is node or mid, not '$place'" >&2; exit 2 ;; esac
+extra=()
+case $place in
+  node) suffix= ;;
+  mid) suffix=_mid ;;
+  rate) suffix=_rate extra=(--set materials.concrete.strength.tension_rate=malvar-ross) ;;
+  *) echo "study.sh: the variant is node, mid or rate, not '$place'" >&2; exit 2 ;;
+esac
 mkdir -p study
 # 004 Table 5's end times.
 end_time() { case $1 in 434) echo 2ms ;; 606) echo 0.6ms ;; 749) echo 0.5ms ;; 1058) echo 0.3ms ;; *) echo 0.5ms ;; esac; }
@@ -45,7 +54,8 @@ for cv in "${cases[@]}"; do
     --set "grid.domain.min=0 0 $(floor_z "$c") mm" --set "grid.levels.0.min=0 0 $(floor_z "$c") mm" \
     --set "grid.levels.0.max=$(level_box "$c")" \
     --set "bodies.projectile.velocity=0 0 -$v m/s" --set "solver.end_time=$(end_time "$v")" \
-    --set "scene.title=V5 $v m/s, level 1 $c${suffix:+, struck face mid-cell}" -o study/$name.model 2> study/prep_$name.log
+    --set "scene.title=V5 $v m/s, level 1 $c${suffix:+, ${place}}" "${extra[@]}" \
+    -o study/$name.model 2> study/prep_$name.log
   status=0
   "$bin/mpm-run/mpm-run" study/$name.model -o study/$name.mpm --threads "$threads" --stats \
     --progress none 2> study/run_$name.log || status=$?

@@ -16,6 +16,15 @@ import sys
 EXPERIMENT = {434: 214, 606: 449, 749: 615, 1058: 947}  # Hanchak et al. 1992 (004 Table 5)
 SEED = {434: 200, 606: 413, 749: 584, 1058: 908}  # 004 Table 5, MGMPM
 SEED_MIN = {434: 216, 606: 52, 749: 40, 1058: 31}  # 004 Table 5, MGMPM CPU minutes
+# The variants study.sh runs beside the scene (case suffix, table heading, column name).
+VARIANTS = [
+    ("mid", "Placement (`make placement`): the slab's struck face midway between level 2's node "
+     "planes (the floor half a level-2 cell lower) against it on a node plane, same cells:",
+     "face mid-cell"),
+    ("rate", "Rate-dependent tension (`make tension`): HJC's T times Malvar and Ross's factor at "
+     "the largest principal strain rate (tension_rate = \"malvar-ross\") against HJC as "
+     "published, same cells:", "T rate-dependent"),
+]
 
 
 def read_case(study, name):
@@ -114,34 +123,33 @@ def main():
             "| v0 | cells (mm) | v_r (m/s) | change | under 3% |",
             "|---|---|---|---|---|",
         ] + pairs + [""]
-    # Placement (make placement): each speed with the struck face midway between level 2's node
-    # planes against the same cell with it on a node plane.
-    places = []
-    for path in sorted(glob.glob(os.path.join(study, "residual_c*_*_mid.json"))):
-        m = re.match(r"residual_c([0-9.]+)_(\d+)_mid\.json$", os.path.basename(path))
-        if not m:
-            continue
-        cell, v = m.group(1), int(m.group(2))
-        mid, node = read_case(study, f"c{cell}_{v}_mid"), read_case(study, f"c{cell}_{v}")
-        if not mid or mid.get("vr") is None or v not in EXPERIMENT:
-            continue
-        vm = mid["vr"]
-        err = f"{100 * (vm - EXPERIMENT[v]) / EXPERIMENT[v]:+.1f}%"
-        if node and node.get("vr") is not None:
-            places.append((v, float(cell), f"| {v} | {cell} | {node['vr']:.1f} | {vm:.1f} "
-                           f"| {100 * (vm - node['vr']) / node['vr']:+.1f}% | {err} |"))
-        else:
-            places.append((v, float(cell), f"| {v} | {cell} | - | {vm:.1f} | | {err} |"))
-    if places:
-        lines += [
-            "Placement (`make placement`): the slab's struck face midway between level 2's node "
-            "planes (the floor half a level-2 cell lower) against it on a node plane, same cells:",
-            "",
-            "| v0 | cell (mm) | v_r, face on a node plane | v_r, face mid-cell | change "
-            "| mid-cell against exp |",
-            "|---|---|---|---|---|---|",
-        ] + [row for _, _, row in sorted(places)] + [""]
-        rows += len(places)
+    # Variants at the same cells (make placement, make tension): each speed against the scene
+    # as it is.
+    for suffix, title, column in VARIANTS:
+        found = []
+        for path in sorted(glob.glob(os.path.join(study, f"residual_c*_*_{suffix}.json"))):
+            m = re.match(rf"residual_c([0-9.]+)_(\d+)_{suffix}\.json$", os.path.basename(path))
+            if not m:
+                continue
+            cell, v = m.group(1), int(m.group(2))
+            var, base = read_case(study, f"c{cell}_{v}_{suffix}"), read_case(study, f"c{cell}_{v}")
+            if not var or var.get("vr") is None or v not in EXPERIMENT:
+                continue
+            vv = var["vr"]
+            err = f"{100 * (vv - EXPERIMENT[v]) / EXPERIMENT[v]:+.1f}%"
+            if base and base.get("vr") is not None:
+                found.append((v, float(cell), f"| {v} | {cell} | {base['vr']:.1f} | {vv:.1f} "
+                              f"| {100 * (vv - base['vr']) / base['vr']:+.1f}% | {err} |"))
+            else:
+                found.append((v, float(cell), f"| {v} | {cell} | - | {vv:.1f} | | {err} |"))
+        if found:
+            lines += [
+                title,
+                "",
+                f"| v0 | cell (mm) | v_r, the scene | v_r, {column} | change | {column} against exp |",
+                "|---|---|---|---|---|---|",
+            ] + [row for _, _, row in sorted(found)] + [""]
+            rows += len(found)
     open(os.path.join(study, "table.md"), "w").write("\n".join(lines) + "\n")
     if not rows:
         sys.exit("table.py: no finished case in " + study)

@@ -7,6 +7,8 @@
 #include <cctype>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <utility>
 
 #include "run_command.hpp"
 
@@ -103,6 +105,105 @@ TEST(HjcCli, CubeRunsWithDamageColumns) {
   EXPECT_LE(D, 1.0);
 }
 
+// An eighth of a 40 mm concrete cube expanding equally on all three axes at 1000 /s (velocity
+// 1000 x, 1000 y, 1000 z; slip on the three symmetry planes), 2 us: by about 1.2 us its
+// pressure K mu reaches the tension cut, which then holds it. Inside, 5 mm from the symmetry
+// planes and 15 mm from the free faces (the release from them travels 7.7 mm in 2 us), no
+// force acts, so each particle keeps its velocity and the rate of deformation is 1000 /
+// (1 + 1000 t) /s on all three axes. The cut there at the last step: T = 4 MPa with HJC as
+// published; with tension_rate = "malvar-ross", T x 14.199866584204333 (the factor at 1000 /s)
+// x (rate / 1000)^(1/3) = 56.76165 MPa at t = 2 us, 56.76390 MPa at the last step's start
+// (1.881 us): 56.7628 MPa +- 1.2 kPa; with tension_dif_max = 5, 20 MPa.
+const char* kExpanding = R"([materials.concrete]
+density = "2440 kg/m^3"
+shear_modulus = "14.86 GPa"
+[materials.concrete.strength]
+model = "hjc"
+A = 0.79
+B = 1.60
+N = 0.61
+C = 0.007
+fc = "48 MPa"
+T = "4 MPa"
+S_max = 7.0
+D1 = 0.04
+D2 = 1.0
+EF_min = 0.01
+[materials.concrete.eos]
+model = "hjc"
+P_crush = "16 MPa"
+mu_crush = 0.001
+P_lock = "0.80 GPa"
+mu_lock = 0.10
+K1 = "85 GPa"
+K2 = "-171 GPa"
+K3 = "208 GPa"
+[[bodies]]
+name = "cube"
+material = "concrete"
+shape = "box"
+size = "20 20 20 mm"
+translate = "10 10 10 mm"
+velocity_field = ["1000*x", "1000*y", "1000*z"]
+[grid]
+cell_size = "1 mm"
+domain = { min = "0 0 0 mm", max = "24 24 24 mm" }
+[boundary]
+x_min = "slip"
+y_min = "slip"
+z_min = "slip"
+[solver]
+end_time = "2 us"
+[output]
+frames = 1
+)";
+
+TEST(HjcCli, ExpandingCubeHoldsTheRateDependentTensionCut) {
+  const auto dir = temp_dir("hjc_expanding");
+  // The mean tension (sigma_xx = sigma_yy = sigma_zz, no deviator) of the particles within
+  // 5 mm of the corner, least and most.
+  const auto held = [&](const std::string& strength_keys) {
+    std::string text = kExpanding;
+    const std::string at = "EF_min = 0.01\n";
+    text.replace(text.find(at), at.size(), at + strength_keys);
+    const fs::path scene = write(dir, "cube.toml", text);
+    const Result r = prep_and_run(scene, "", dir / "cube.mpm", dir);
+    EXPECT_EQ(r.status, 0) << r.err;
+    const Result csv = run(
+        post + " particles " + (dir / "cube.mpm").string() + " --columns x,sigma --digits 12", dir);
+    EXPECT_EQ(csv.status, 0) << csv.err;
+    std::istringstream in(csv.out);
+    std::string line;
+    double lo = 1e300, hi = -1e300;
+    int n = 0;
+    while (std::getline(in, line)) {
+      if (line.empty() || !(std::isdigit(line[0]) || line[0] == '-')) continue;
+      std::istringstream row(line);
+      std::string cell;
+      double v[9];
+      for (double& x : v) {
+        std::getline(row, cell, ',');
+        x = std::stod(cell);
+      }
+      if (v[0] > 5e-3 || v[1] > 5e-3 || v[2] > 5e-3) continue;
+      EXPECT_EQ(v[3], v[4]);
+      EXPECT_EQ(v[3], v[5]);
+      lo = std::min(lo, v[3]), hi = std::max(hi, v[3]), ++n;
+    }
+    EXPECT_GT(n, 100);
+    return std::pair{lo, hi};
+  };
+  const auto plain = held("");
+  EXPECT_NEAR(plain.first, 4e6, 1.0);
+  EXPECT_NEAR(plain.second, 4e6, 1.0);
+  const auto rate = held("tension_rate = \"malvar-ross\"\n");
+  EXPECT_NEAR(rate.first, 56.7628e6, 1.2e3);
+  EXPECT_NEAR(rate.second, 56.7628e6, 1.2e3);
+  const auto capped = held("tension_rate = \"malvar-ross\"\ntension_dif_max = 5\n");
+  EXPECT_NEAR(capped.first, 20e6, 5.0);
+  EXPECT_NEAR(capped.second, 20e6, 5.0);
+}
+
 TEST(HjcCli, BadHjcInputExitsTwo) {
   const auto dir = temp_dir("hjc_bad");
   struct Case {
@@ -116,6 +217,16 @@ TEST(HjcCli, BadHjcInputExitsTwo) {
        "bad.toml:21: materials.concrete.eos.mu_lock: must be > 0"},
       {"model = \"hjc\"\nA", "model = \"j2\"\nA",
        "bad.toml:8: materials.concrete.strength.N: not used by this model"},
+      // The opt-in rate-dependent tensile strength: a law it knows, a cap of at least 1, and
+      // the cap only with a law.
+      {"EF_min = 0.01\n", "EF_min = 0.01\ntension_rate = \"fast\"\n",
+       "bad.toml:16: materials.concrete.strength.tension_rate: expected one of \"none\", "
+       "\"malvar-ross\", got 'fast'"},
+      {"EF_min = 0.01\n", "EF_min = 0.01\ntension_rate = \"malvar-ross\"\ntension_dif_max = 0.5\n",
+       "bad.toml:17: materials.concrete.strength.tension_dif_max: must be at least 1"},
+      {"EF_min = 0.01\n", "EF_min = 0.01\ntension_dif_max = 8\n",
+       "bad.toml:16: materials.concrete.strength.tension_dif_max: caps the rate law of "
+       "tension_rate; set tension_rate = \"malvar-ross\" too"},
   };
   for (const auto& c : cases) {
     std::string text = kCube;

@@ -6,10 +6,12 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "mpm/core/error.hpp"
 #include "mpm/scene/particles.hpp"
 #include "mpm/solver/materials/material.hpp"
+#include "mpm/solver/materials/models.hpp"
 
 namespace mpm {
 namespace {
@@ -267,6 +269,111 @@ TEST(Hjc, FullyDamagedExpandedConcreteKeepsTheStepOfRho0) {
     EXPECT_EQ(d.sigma.norm(), 0.0) << ratio;  // p = K mu < 0 is past the cut-off T (1 - D) = 0
     EXPECT_NEAR(d.c, c0, 1e-9 * c0) << ratio;
   }
+}
+
+// The opt-in rate-dependent tensile strength: Malvar and Ross's (1998) factor for f'c = 48 MPa,
+// delta = 1 / (1 + 8 x 4.8) = 0.025380710659898477, beta = 10^(6 delta - 2) =
+// 0.014199866584204338: (rate / 1e-6 /s)^delta up to 1 /s, beta (rate / 1e-6 /s)^(1/3) above;
+// hand values 1.1916319307657184 at 1e-3 /s, 1.4199866584204337 at 1 /s (both branches),
+// 6.590994217603407 at 100 /s, 14.199866584204333 at 1000 /s.
+TEST(Hjc, TensionRateFactorIsMalvarRoss) {
+  HjcSpec h = concrete().hjc;
+  EXPECT_EQ(hjc_tension_dif(h, 1000.0), 1.0);  // tension_rate "none": HJC as published
+  h.tension_rate = HjcSpec::TensionRate::MalvarRoss;
+  EXPECT_EQ(hjc_tension_dif(h, 1e-7), 1.0);   // below the quasi-static rate: T itself
+  EXPECT_EQ(hjc_tension_dif(h, -50.0), 1.0);  // no stretching (compression on every axis)
+  EXPECT_NEAR(hjc_tension_dif(h, 1e-3), 1.1916319307657184, 1e-13);
+  EXPECT_NEAR(hjc_tension_dif(h, 1.0), 1.4199866584204337, 1e-13);
+  EXPECT_NEAR(hjc_tension_dif(h, 1.0 + 1e-9), 1.4199866588937624, 1e-13);  // continuous at 1 /s
+  EXPECT_NEAR(hjc_tension_dif(h, 100.0), 6.590994217603407, 1e-12);
+  EXPECT_NEAR(hjc_tension_dif(h, 1000.0), 14.199866584204333, 1e-12);
+  h.tension_dif_max = 5.0;
+  EXPECT_EQ(hjc_tension_dif(h, 1000.0), 5.0);
+  EXPECT_NEAR(hjc_tension_dif(h, 1.0), 1.4199866584204337, 1e-13);  // below the cap: the law
+}
+
+// The largest principal value that the rate law reads, against tensors with known eigenvalues:
+// diagonal ones in any order, and diag(3, 1, -2) turned by 30 degrees about z (xx = 3 cos^2 +
+// sin^2 = 2.5, yy = 1.5, xy = (3 - 1) sin cos = 0.8660254037844386).
+TEST(Hjc, LargestPrincipalValue) {
+  Sym a;
+  a << -1, 4, 2, 0, 0, 0;
+  EXPECT_NEAR(largest_eigenvalue(a), 4.0, 1e-14);
+  a << 0.5, 0.5, 0.5, 0, 0, 0;  // isotropic: J2 = 0
+  EXPECT_EQ(largest_eigenvalue(a), 0.5);
+  a << 2.5, 1.5, -2, 0, 0, 0.8660254037844386;
+  EXPECT_NEAR(largest_eigenvalue(a), 3.0, 1e-14);
+  a << 0, 0, 0, 0, 0, 2;  // pure shear: +-2
+  EXPECT_NEAR(largest_eigenvalue(a), 2.0, 1e-14);
+}
+
+// Expanded equally on all three axes at 1000 /s for one step of 2 us (tr D dt = 0.006, so
+// rho0 / rho - 1 = 0.006 and the elastic pressure K mu would be -95.4 MPa; no deviator, no
+// bulk viscosity in expansion), the concrete holds the tension cut: T = 4 MPa as published,
+// 14.199866584204333 T = 56.79946633681733 MPa with the rate law (the largest principal strain
+// rate is 1000 /s), 5 T = 20 MPa with the factor capped at 5.
+TEST(Hjc, TensionCutFollowsTheStrainRate) {
+  SolverSpec solver;
+  const Mat3 L = Mat3::Identity() * 1000.0;
+  const auto held = [&](const MaterialSpec& spec) {
+    const Material mat(spec, solver);
+    Point p;
+    p.update(mat, L, 2e-6, false);
+    EXPECT_EQ(p.sigma[0], p.sigma[1]);
+    EXPECT_EQ(p.sigma[3], 0.0);
+    return p.sigma[0];  // tension positive
+  };
+  MaterialSpec spec = concrete();
+  EXPECT_NEAR(held(spec), 4e6, 1e-6);
+  spec.hjc.tension_rate = HjcSpec::TensionRate::MalvarRoss;
+  EXPECT_NEAR(held(spec), 56.79946633681733e6, 1e-5);
+  spec.hjc.tension_dif_max = 5.0;
+  EXPECT_NEAR(held(spec), 20e6, 1e-6);
+}
+
+// The strength's tension branch and the fracture strain take the same T: at 100 /s T is
+// 6.590994217603407 x 4 MPa = 26.363976870413627 MPa, so at P = -2 MPa the flow stress is
+// 0.79 (1 - 2 / 26.363976870413627) 48 MPa = 35.04334749902206 MPa (18.96 MPa with the static
+// T), and the fracture strain at P* = 0 is D1 T* = 0.04 x 26.364 / 48 = 0.021969980725344687
+// (above EF_min = 0.01, which holds with the static T*): sheared by de_xy = 0.0015 at P = 0
+// (q_tr = 77.214832 MPa over the flow stress 37.92 MPa) the damage is d eps_p / 0.02197.
+TEST(Hjc, StrengthAndDamageTakeTheRateDependentT) {
+  MaterialSpec m = concrete();
+  m.hjc.tension_rate = HjcSpec::TensionRate::MalvarRoss;
+  const auto st = model_registry().strength.at("hjc")(m);
+  EXPECT_TRUE(st->rate_dependent_tension());
+  EXPECT_FALSE(model_registry().strength.at("hjc")(concrete())->rate_dependent_tension());
+  const auto sheared = [&](double p, double g, double rate) {
+    static BlockScratch S;
+    double rho = m.density, eps_p = 0, D = 0, mu_max = 0;
+    MaterialBlock b;
+    b.n = 1;
+    b.dt = kSlow;
+    b.rho = &rho;
+    b.eps_p = &eps_p;
+    b.damage = &D;
+    b.mu_max = &mu_max;
+    // rate > 0: the factor at that rate, handed in; rate < 0: the model works it out (NaN)
+    // from L, stretched along x only (uniaxial strain, as in a spall plane) at -rate.
+    const Mat3 L = Eigen::Vector3d(-rate, 0, 0).asDiagonal();
+    b.L = &L;
+    double factor = rate > 0 ? hjc_tension_dif(m.hjc, rate) : std::nan("");
+    b.tension_factor = &factor;
+    S.p[0] = p;
+    S.s[0].setZero();
+    S.de[0].setZero();
+    S.de[0][5] = g;
+    st->update(b, S, m.shear_modulus());
+    return std::pair{S.yield[0], D};
+  };
+  EXPECT_NEAR(sheared(-2e6, 1e-6, 100.0).first, 35.04334749902206e6, 1e-12 * 1e8);
+  EXPECT_NEAR(sheared(-2e6, 1e-6, 1e-7).first, 18.96e6, 1e-12 * 1e8);
+  EXPECT_NEAR(sheared(-2e6, 1e-6, -100.0).first, 35.04334749902206e6, 1e-12 * 1e8);
+  const double G = m.shear_modulus();
+  const double dl = (2 * G * std::sqrt(3.0) * 0.0015 - 37.92e6) / (3 * G);
+  EXPECT_NEAR(sheared(0, 0.0015, 100.0).second, dl / 0.021969980725344687, 1e-12);
+  EXPECT_NEAR(sheared(0, 0.0015, 1e-7).second, dl / 0.01, 1e-12);
+  EXPECT_NEAR(sheared(0, 0.0015, -100.0).second, dl / 0.021969980725344687, 1e-12);
 }
 
 TEST(Hjc, ColumnsOnlyWhenUsed) {

@@ -1,6 +1,8 @@
 #pragma once
 /// Basic numeric types shared by every part of the toolchain. SI units throughout.
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 namespace mpm {
@@ -47,6 +49,19 @@ inline Sym deviator(const Sym& s) {
 /// Double contraction a:b of two symmetric tensors in Voigt order.
 inline double ddot(const Sym& a, const Sym& b) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + 2.0 * (a[3] * b[3] + a[4] * b[4] + a[5] * b[5]);
+}
+/// Largest principal value of a symmetric tensor: its mean plus that of its deviator d,
+/// 2 sqrt(J2 / 3) cos(theta) with cos(3 theta) = (3 sqrt(3) / 2) J3 / J2^(3/2), theta in
+/// [0, pi / 3] (J2 = d:d / 2, J3 = det d; the closed form of the cubic's largest root).
+inline double largest_eigenvalue(const Sym& s) {
+  const Sym d = deviator(s);
+  const double J2 = 0.5 * ddot(d, d);
+  const double mean = trace(s) / 3.0;
+  if (!(J2 > 0)) return mean;
+  const double J3 = d[0] * (d[1] * d[2] - d[3] * d[3]) - d[5] * (d[5] * d[2] - d[3] * d[4]) +
+                    d[4] * (d[5] * d[3] - d[1] * d[4]);
+  const double c = std::clamp(1.5 * std::sqrt(3.0) * J3 / (J2 * std::sqrt(J2)), -1.0, 1.0);
+  return mean + 2.0 * std::sqrt(J2 / 3.0) * std::cos(std::acos(c) / 3.0);
 }
 /// Von Mises equivalent of a stress, sqrt(3/2 s:s), in the stress's unit.
 inline double von_mises(const Sym& s) {

@@ -12,15 +12,16 @@ namespace mpm::scene_toml {
 
 namespace {
 
-const std::initializer_list<std::string_view> kHjcStrengthKeys = {"N",  "fc", "T",     "S_max",
-                                                                  "D1", "D2", "EF_min"};
+const std::initializer_list<std::string_view> kHjcStrengthKeys = {
+    "N", "fc", "T", "S_max", "D1", "D2", "EF_min", "tension_rate", "tension_dif_max"};
 
 // HJC strength and damage (Holmquist, Johnson & Cook 1993); the constants of 004 Table 4 are
 // the examples.
 void read_hjc_strength(Reader& r, HjcSpec& h) {
   r.reject({"n", "m", "room_temperature", "melt_temperature", "specific_heat", "taylor_quinney",
             "yield_stress", "tangent_modulus"},
-           "by the hjc model (its keys: A, B, N, C, fc, T, S_max, reference_rate, D1, D2, EF_min)");
+           "by the hjc model (its keys: A, B, N, C, fc, T, S_max, reference_rate, D1, D2, EF_min, "
+           "tension_rate, tension_dif_max)");
   h.A = r.required("A", dim::none, Bound::NonNegative, "0.79", "normalised cohesion");
   h.B = r.required("B", dim::none, Bound::NonNegative, "1.60", "normalised pressure hardening");
   h.N = r.required("N", dim::none, Bound::Positive, "0.61", "pressure hardening exponent");
@@ -35,6 +36,18 @@ void read_hjc_strength(Reader& r, HjcSpec& h) {
   h.D2 = r.required("D2", dim::none, Bound::NonNegative, "1.0", "damage exponent");
   h.EF_min = r.required("EF_min", dim::none, Bound::Positive, "0.01",
                         "the least plastic strain to fracture");
+  // Opt-in: T rises with the strain rate (docs/scene.md, HJC concrete).
+  h.tension_rate = r.choice<HjcSpec::TensionRate>(
+                        "tension_rate", {{"none", HjcSpec::TensionRate::None},
+                                         {"malvar-ross", HjcSpec::TensionRate::MalvarRoss}})
+                       .value_or(HjcSpec::TensionRate::None);
+  if (const auto cap = r.quantity("tension_dif_max", dim::none, Bound::Positive)) {
+    r.check("tension_dif_max", *cap >= 1.0,
+            "must be at least 1 (the factor on T at the quasi-static rate)");
+    r.check("tension_dif_max", h.tension_rate != HjcSpec::TensionRate::None,
+            "caps the rate law of tension_rate; set tension_rate = \"malvar-ross\" too");
+    h.tension_dif_max = *cap;
+  }
   r.finish();
 }
 
@@ -308,7 +321,9 @@ MaterialSpec read_material(Reader& r, const std::string& name, std::vector<std::
                                     "S_max",
                                     "D1",
                                     "D2",
-                                    "EF_min"})) {
+                                    "EF_min",
+                                    "tension_rate",
+                                    "tension_dif_max"})) {
     read_strength(*t, m.strength, m.hjc);
     const bool bilinear = m.strength.model == StrengthModel::Bilinear;
     yield_at = t->loc_of(bilinear ? "yield_stress" : "A");

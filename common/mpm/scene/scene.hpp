@@ -2,6 +2,7 @@
 /// The scene: what the user describes in a TOML file (reference: docs/scene.md). Every string
 /// is parsed into an enum or a typed SI value here, once; nothing past the parser sees text.
 #include <array>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <string>
@@ -88,6 +89,12 @@ struct HjcSpec {
   double P_crush = 0, mu_crush = 0;  ///< end of the elastic region, Pa and -
   double P_lock = 0, mu_lock = 0;    ///< lock pressure (Pa), and the fully dense curve's p = 0
   double K1 = 0, K2 = 0, K3 = 0;     ///< fully dense curve, Pa
+  /// How T follows the strain rate: None (HJC as published, T at every rate), or MalvarRoss
+  /// (T times Malvar and Ross's 1998 dynamic increase factor of concrete in tension at the
+  /// particle's largest principal strain rate, at most tension_dif_max).
+  enum class TensionRate : std::uint8_t { None, MalvarRoss };
+  TensionRate tension_rate = TensionRate::None;
+  double tension_dif_max = std::numeric_limits<double>::infinity();
   double K_elastic() const { return P_crush / mu_crush; }
 };
 

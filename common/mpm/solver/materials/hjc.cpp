@@ -11,6 +11,37 @@ namespace mpm {
 
 namespace {
 
+/// Malvar & Ross's (1998) dynamic increase factor of concrete's tensile strength (ACI
+/// Materials Journal 95(6): the CEB-FIP form refitted to tension data), with its constants for
+/// f'c worked out once: delta = 1 / (1 + 8 f'c / f'co), f'co = 10 MPa, log10 beta = 6 delta -
+/// 2; at rates over the quasi-static 1e-6 /s it is (rate / 1e-6)^delta up to 1 /s and
+/// beta (rate / 1e-6)^(1/3) above (the two meet at 1 /s); at most tension_dif_max; 1 for
+/// tension_rate None.
+struct TensionDif {
+  bool on = false;
+  double delta = 0, beta_cbrt = 0, cap = 1;  ///< beta_cbrt = beta / cbrt(1e-6)
+  explicit TensionDif(const HjcSpec& h)
+      : on(h.tension_rate != HjcSpec::TensionRate::None),
+        delta(1.0 / (1.0 + 8.0 * h.fc / 10e6)),
+        beta_cbrt(std::pow(10.0, 6.0 * delta - 2.0) * 100.0),
+        cap(h.tension_dif_max) {}
+  double operator()(double rate) const {
+    constexpr double static_rate = 1e-6;
+    if (!on || !(rate > static_rate)) return 1.0;
+    const double dif =
+        rate <= 1.0 ? std::pow(rate / static_rate, delta) : beta_cbrt * std::cbrt(rate);
+    return std::min(dif, cap);
+  }
+  /// Particle i's factor this step, at the largest principal value of sym(L): worked out on the
+  /// first call (b.tension_factor NaN) and kept; 1 without a rate-dependent tension.
+  double of(const MaterialBlock& b, int i) const {
+    if (!b.tension_factor) return 1.0;
+    double& f = b.tension_factor[i];
+    if (std::isnan(f)) f = (*this)(largest_eigenvalue(to_voigt(b.L[i])));
+    return f;
+  }
+};
+
 /// HJC's pressure against the volumetric strain mu = rho / rho0 - 1 (P in Pa):
 ///   elastic     mu <= mu_crush:               P = K_e mu, K_e = P_crush / mu_crush
 ///   crushing    mu_crush < mu <= mu_plock:    P linear from (mu_crush, P_crush) to
@@ -23,7 +54,7 @@ namespace {
 /// dense curve from zero at mu_lock would drop by P_lock there). Once crushed to mu_max, the
 /// material unloads and reloads along the line from (mu_max, P(mu_max)) of modulus
 /// K_u = (1 - F) K_e + F K1, F = (mu_max - mu_crush) / (mu_plock - mu_crush); past mu_plock it
-/// follows the dense curve (K1 m below m = 0). Tension is cut at -T (1 - D).
+/// follows the dense curve (K1 m below m = 0). HjcEos cuts tension at -T (1 - D).
 struct HjcPressure {
   HjcSpec h;
   double K_e = 0;       ///< elastic bulk modulus, Pa
@@ -57,9 +88,9 @@ struct HjcPressure {
     const double F = (m - h.mu_crush) / (mu_plock - h.mu_crush);
     return (1.0 - F) * K_e + F * h.K1;
   }
-  /// Pressure at mu after the largest compression mu_max, with damage D (Pa), and dP/dmu of
-  /// the stiffest path open from there (loading or unloading) in `slope`.
-  double pressure(double mu, double mu_max, double D, double& slope) const {
+  /// Pressure at mu after the largest compression mu_max (Pa), before the tension cut, and
+  /// dP/dmu of the stiffest path open from there (loading or unloading) in `slope`.
+  double pressure(double mu, double mu_max, double& slope) const {
     const double m = std::max(mu_max, mu);
     double p;
     if (m <= h.mu_crush) {
@@ -73,7 +104,7 @@ struct HjcPressure {
       p = dense_of(bar(mu));
       slope = dense_slope_of(bar(mu)) / (1.0 + h.mu_lock);
     }
-    return std::max(p, -h.T * (1.0 - D));
+    return p;
   }
   /// Plastic volumetric strain after crushing to mu_max: where its unloading path has P = 0.
   double plastic_volumetric_strain(double mu_max) const {
@@ -83,31 +114,41 @@ struct HjcPressure {
   }
 };
 
-/// The pressure of HJC concrete, p = A(rho, mu_max, D) with no energy term (B = 0).
+/// The pressure of HJC concrete, p = A(rho, mu_max, D) with no energy term (B = 0): the curve
+/// of HjcPressure cut at -T (1 - D), T at the particle's rate with a rate-dependent tension.
 class HjcEos final : public Eos {
  public:
-  explicit HjcEos(const MaterialSpec& m) : rho0_(m.density), curve_(m.hjc) {}
-  /// Virgin material (no crushing, no damage): the loading curve.
+  explicit HjcEos(const MaterialSpec& m) : rho0_(m.density), curve_(m.hjc), dif_(m.hjc) {}
+  /// Virgin material (no crushing, no damage) at the quasi-static rate: the loading curve.
   void coefficients(int n, const double* rho, const double* /*e*/, double* A, double* B,
                     double* K) const override {
-    for (int i = 0; i < n; ++i) set(i, rho[i], 0.0, 0.0, A, B, K);
+    for (int i = 0; i < n; ++i) {
+      set(i, rho[i], 0.0, A, B, K);
+      A[i] = std::max(A[i], -curve_.h.T);
+    }
   }
   void block_coefficients(const MaterialBlock& b, const double* /*e*/, double* A, double* B,
                           double* K) const override {
-    for (int i = 0; i < b.n; ++i)
-      set(i, b.rho[i], b.mu_max ? b.mu_max[i] : 0.0, b.damage ? b.damage[i] : 0.0, A, B, K);
+    for (int i = 0; i < b.n; ++i) {
+      set(i, b.rho[i], b.mu_max ? b.mu_max[i] : 0.0, A, B, K);
+      // The tension cut at -T (1 - D); T rate-dependent only where the cut of T itself (the
+      // least it can be) holds.
+      const double cut = -curve_.h.T * (1.0 - (b.damage ? b.damage[i] : 0.0));
+      if (A[i] < cut) A[i] = std::max(A[i], cut * dif_.of(b, i));
+    }
   }
 
  private:
-  void set(int i, double rho, double mu_max, double D, double* A, double* B, double* K) const {
+  void set(int i, double rho, double mu_max, double* A, double* B, double* K) const {
     const double mu = rho / rho0_ - 1.0;
     double slope;
-    A[i] = curve_.pressure(mu, mu_max, D, slope);
+    A[i] = curve_.pressure(mu, mu_max, slope);
     B[i] = 0.0;
     K[i] = (1.0 + mu) * slope;  // rho dP/drho
   }
   double rho0_;
   HjcPressure curve_;
+  TensionDif dif_;
 };
 
 /// HJC strength: sigma_y = f'c sigma*, sigma* = (A (1 - D) + B P*^N)(1 + C ln(rate*)) for
@@ -116,31 +157,37 @@ class HjcEos final : public Eos {
 /// equivalent deviatoric strain rate. Radial return at the flow stress of the step's start
 /// (pressure at the new density, damage of t^n), then damage D += (d eps_p + d mu_p) / eps_f,
 /// eps_f = max(EF_min, D1 (P* + T*)^D2), D <= 1, with mu_p the plastic volumetric strain of
-/// the crushing (HjcPressure::plastic_volumetric_strain).
+/// the crushing (HjcPressure::plastic_volumetric_strain). With a rate-dependent tensile strength
+/// T* is T hjc_tension_dif(rate_1) / f'c in the tension branch and the fracture strain, rate_1
+/// the largest principal strain rate (the EOS cuts at the same T).
 class HjcStrength final : public Strength {
  public:
   explicit HjcStrength(const MaterialSpec& m)
-      : h_(m.hjc), rho0_(m.density), T_star_(m.hjc.T / m.hjc.fc), curve_(m.hjc) {}
+      : h_(m.hjc), rho0_(m.density), T_star_(m.hjc.T / m.hjc.fc), curve_(m.hjc), dif_(m.hjc) {}
 
   bool needs_plastic_strain() const override { return true; }
   bool needs_pressure() const override { return true; }
+  bool rate_dependent_tension() const override {
+    return h_.tension_rate != HjcSpec::TensionRate::None;
+  }
 
-  /// Normalised strength sigma* at P*, damage D and equivalent strain rate (1/s).
-  double normalised(double P_star, double D, double rate) const {
+  /// Normalised strength sigma* at P*, damage D, equivalent strain rate (1/s) and normalised
+  /// tensile strength T*.
+  double normalised(double P_star, double D, double rate, double T_star) const {
     const double R =
         rate > h_.reference_rate ? 1.0 + h_.C * std::log(rate / h_.reference_rate) : 1.0;
     const double s = P_star >= 0 ? h_.A * (1.0 - D) + h_.B * std::pow(P_star, h_.N)
-                                 : std::max(0.0, h_.A * ((1.0 - D) + P_star / T_star_));
+                                 : std::max(0.0, h_.A * ((1.0 - D) + P_star / T_star));
     return std::min(s * R, h_.S_max);
   }
-  /// Fracture strain at P*: max(EF_min, D1 (P* + T*)^D2).
-  double fracture_strain(double P_star) const {
-    return std::max(h_.EF_min, h_.D1 * std::pow(std::max(P_star + T_star_, 0.0), h_.D2));
+  /// Fracture strain at P* and T*: max(EF_min, D1 (P* + T*)^D2).
+  double fracture_strain(double P_star, double T_star) const {
+    return std::max(h_.EF_min, h_.D1 * std::pow(std::max(P_star + T_star, 0.0), h_.D2));
   }
   /// The intact strength at zero pressure (the implicit solver's tangent asks; HJC runs
   /// explicit only).
   double flow_stress(double, double rate, double) const override {
-    return h_.fc * normalised(0.0, 0.0, rate);
+    return h_.fc * normalised(0.0, 0.0, rate, T_star_);
   }
 
   void update(MaterialBlock& b, BlockScratch& S, double G) const override {
@@ -150,7 +197,9 @@ class HjcStrength final : public Strength {
       const Sym s_tr = S.s[i] + 2.0 * G * S.de[i];  // elastic predictor
       const double q_tr = std::sqrt(1.5 * ddot(s_tr, s_tr));
       const double rate = std::sqrt(2.0 / 3.0 * ddot(S.de[i], S.de[i])) / b.dt;
-      const double sy = h_.fc * normalised(P_star, D, rate);
+      // T* at the step's rate where it acts: the tension branch and the fracture strain.
+      const double sy =
+          h_.fc * normalised(P_star, D, rate, P_star < 0 ? T_star_ * dif_.of(b, i) : T_star_);
       double dl = 0.0;
       if (q_tr > sy) {
         dl = (q_tr - sy) / (3.0 * G);
@@ -172,7 +221,7 @@ class HjcStrength final : public Strength {
         }
       }
       if (b.damage && dl + dmu_p > 0) {
-        D += (dl + dmu_p) / fracture_strain(P_star);
+        D += (dl + dmu_p) / fracture_strain(P_star, T_star_ * dif_.of(b, i));
         b.damage[i] = std::min(D, 1.0);
       }
     }
@@ -182,9 +231,14 @@ class HjcStrength final : public Strength {
   HjcSpec h_;
   double rho0_, T_star_;
   HjcPressure curve_;
+  TensionDif dif_;
 };
 
 }  // namespace
+
+double hjc_tension_dif(const HjcSpec& h, double rate) {
+  return TensionDif(h)(rate);
+}
 
 std::unique_ptr<Strength> make_hjc_strength(const MaterialSpec& m) {
   return std::make_unique<HjcStrength>(m);

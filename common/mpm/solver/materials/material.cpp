@@ -386,6 +386,12 @@ void kinematics(MaterialBlock& b, BlockScratch& S) {
 void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
   const double dt = b.dt;
   kinematics(b, S);
+  if (strength_->rate_dependent_tension()) {
+    std::fill_n(S.tension_factor, b.n, std::numeric_limits<double>::quiet_NaN());
+    b.tension_factor = S.tension_factor;
+  } else {
+    b.tension_factor = nullptr;
+  }
 
   // A pressure-dependent strength (HJC) takes the EOS's pressure at the new density and the
   // energy of t^n (exact for an EOS without energy; the energy equation follows below).

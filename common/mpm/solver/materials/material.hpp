@@ -53,6 +53,11 @@ struct MaterialBlock {
   double* damage = nullptr;        ///< HJC damage D (in/out; nullptr if absent)
   double* mu_max = nullptr;        ///< HJC largest compression rho/rho0 - 1 (in/out; or nullptr)
   double* c = nullptr;             ///< out: signal speed for the time step, m/s
+  /// The factor on a rate-dependent tensile strength this step (HJC's T), per particle: NaN
+  /// until the model works it out from L, for the particles that need it (in tension, or
+  /// damaging), and kept for the rest of the step. Set by the update for a strength that has
+  /// one (Strength::rate_dependent_tension), else nullptr (the strength as given).
+  double* tension_factor = nullptr;
   /// 2D plane stress: L(2, 2) on entry is ignored; the update finds the thickness rate that
   /// makes sigma_zz = 0 for each particle (and the density follows the thinning).
   bool plane_stress = false;
@@ -111,6 +116,7 @@ struct BlockScratch {
   double k[kBlock];        ///< half the change of specific volume over the step, m^3/kg
   double e_star[kBlock];   ///< energy before the new pressure's work, J/kg
   double p_new[kBlock];    ///< the new pressure (without viscosity), Pa
+  double tension_factor[kBlock];  ///< MaterialBlock::tension_factor
 };
 
 /// Equation of state, written as p = A(rho) + B(rho) e with e the specific internal energy,
@@ -146,6 +152,9 @@ class Strength {
   /// True when the flow stress depends on the pressure: the update then hands the EOS's
   /// pressure at the new density (before the energy equation) in S.p.
   virtual bool needs_pressure() const { return false; }
+  /// True when the tensile strength (of this model and its EOS) follows the strain rate:
+  /// the update then hands them MaterialBlock::tension_factor.
+  virtual bool rate_dependent_tension() const { return false; }
   /// Elastic-predictor / plastic-corrector for a block: in S.s (rotated s_old), S.de; out S.s,
   /// S.dlambda, S.yield, blk.eps_p, blk.T (adiabatic heating).
   virtual void update(MaterialBlock& blk, BlockScratch& S, double G) const = 0;

@@ -28,4 +28,8 @@ inline double mie_gruneisen_mu_cap(double s) {
 /// three-region pressure with its unloading path and the damaged tension cut-off.
 std::unique_ptr<Strength> make_hjc_strength(const MaterialSpec& m);
 std::unique_ptr<Eos> make_hjc_eos(const MaterialSpec& m);
+/// The factor on HJC's tensile strength T at a largest principal strain rate (1/s): 1 for
+/// tension_rate None, else Malvar and Ross's (1998) dynamic increase factor for f'c, at most
+/// tension_dif_max.
+double hjc_tension_dif(const HjcSpec& h, double rate);
 }  // namespace mpm
