@@ -18,10 +18,8 @@ namespace {
 using namespace mpm::testing;
 namespace fs = std::filesystem;
 
-// An eighth of a 20 mm cube under a frictionless platen at 0.5 m/s (tests/verification/
-// test_hjc.cpp has the physics; here 2 mm cells, 120 us: past the crushing that starts at
-// 30 us, so the damage has grown).
-const char* kCube = R"([materials.concrete]
+// 004 Table 4's concrete (V5), the material of both scenes below.
+const std::string kConcrete = R"([materials.concrete]
 density = "2440 kg/m^3"
 shear_modulus = "14.86 GPa"
 [materials.concrete.strength]
@@ -45,7 +43,12 @@ mu_lock = 0.10
 K1 = "85 GPa"
 K2 = "-171 GPa"
 K3 = "208 GPa"
-[[bodies]]
+)";
+
+// An eighth of a 20 mm cube under a frictionless platen at 0.5 m/s (tests/verification/
+// test_hjc.cpp has the physics; here 2 mm cells, 120 us: past the crushing that starts at
+// 30 us, so the damage has grown).
+const std::string kCube = kConcrete + R"([[bodies]]
 name = "cube"
 material = "concrete"
 shape = "box"
@@ -114,31 +117,7 @@ TEST(HjcCli, CubeRunsWithDamageColumns) {
 // published; with tension_rate = "malvar-ross", T x 14.199866584204333 (the factor at 1000 /s)
 // x (rate / 1000)^(1/3) = 56.76165 MPa at t = 2 us, 56.76390 MPa at the last step's start
 // (1.881 us): 56.7628 MPa +- 1.2 kPa; with tension_dif_max = 5, 20 MPa.
-const char* kExpanding = R"([materials.concrete]
-density = "2440 kg/m^3"
-shear_modulus = "14.86 GPa"
-[materials.concrete.strength]
-model = "hjc"
-A = 0.79
-B = 1.60
-N = 0.61
-C = 0.007
-fc = "48 MPa"
-T = "4 MPa"
-S_max = 7.0
-D1 = 0.04
-D2 = 1.0
-EF_min = 0.01
-[materials.concrete.eos]
-model = "hjc"
-P_crush = "16 MPa"
-mu_crush = 0.001
-P_lock = "0.80 GPa"
-mu_lock = 0.10
-K1 = "85 GPa"
-K2 = "-171 GPa"
-K3 = "208 GPa"
-[[bodies]]
+const std::string kExpanding = kConcrete + R"([[bodies]]
 name = "cube"
 material = "concrete"
 shape = "box"

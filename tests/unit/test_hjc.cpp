@@ -107,14 +107,18 @@ TEST(Hjc, TensionIsCutAtTTimesOneMinusDamage) {
 struct Sheared {
   double yield, dlambda, eps_p, D, mu_max, q;
 };
-Sheared shear(double p, double D, double dt, double mu = 0, double mu_max = 0, double g = 0.01) {
-  const MaterialSpec m = concrete();
-  const auto st = model_registry().strength.at("hjc")(m);
+/// The same for the HJC strength `st` of the material `m`, with the block's velocity gradient L
+/// and tension factor (MaterialBlock::tension_factor; null: none).
+Sheared shear_with(const Strength& st, const MaterialSpec& m, const Mat3* L, double* tension_factor,
+                   double p, double D, double dt, double mu = 0, double mu_max = 0,
+                   double g = 0.01) {
   static BlockScratch S;
   double rho = m.density * (1 + mu), eps_p = 0;
   MaterialBlock b;
   b.n = 1;
   b.dt = dt;
+  b.L = L;
+  b.tension_factor = tension_factor;
   b.rho = &rho;
   b.eps_p = &eps_p;
   b.damage = &D;
@@ -123,8 +127,13 @@ Sheared shear(double p, double D, double dt, double mu = 0, double mu_max = 0, d
   S.s[0].setZero();
   S.de[0].setZero();
   S.de[0][5] = g;
-  st->update(b, S, m.shear_modulus());
+  st.update(b, S, m.shear_modulus());
   return {S.yield[0], S.dlambda[0], eps_p, D, mu_max, std::sqrt(1.5 * ddot(S.s[0], S.s[0]))};
+}
+Sheared shear(double p, double D, double dt, double mu = 0, double mu_max = 0, double g = 0.01) {
+  const MaterialSpec m = concrete();
+  const auto st = model_registry().strength.at("hjc")(m);
+  return shear_with(*st, m, nullptr, nullptr, p, D, dt, mu, mu_max, g);
 }
 
 // The equivalent strain rate of de_xy = g over dt is sqrt(2/3 x 2 g^2) / dt = 2 g / (sqrt(3) dt):
@@ -343,28 +352,13 @@ TEST(Hjc, StrengthAndDamageTakeTheRateDependentT) {
   const auto st = model_registry().strength.at("hjc")(m);
   EXPECT_TRUE(st->rate_dependent_tension());
   EXPECT_FALSE(model_registry().strength.at("hjc")(concrete())->rate_dependent_tension());
+  // rate > 0: the factor at that rate, handed in; rate < 0: the model works it out (NaN)
+  // from L, stretched along x only (uniaxial strain, as in a spall plane) at -rate.
   const auto sheared = [&](double p, double g, double rate) {
-    static BlockScratch S;
-    double rho = m.density, eps_p = 0, D = 0, mu_max = 0;
-    MaterialBlock b;
-    b.n = 1;
-    b.dt = kSlow;
-    b.rho = &rho;
-    b.eps_p = &eps_p;
-    b.damage = &D;
-    b.mu_max = &mu_max;
-    // rate > 0: the factor at that rate, handed in; rate < 0: the model works it out (NaN)
-    // from L, stretched along x only (uniaxial strain, as in a spall plane) at -rate.
     const Mat3 L = Eigen::Vector3d(-rate, 0, 0).asDiagonal();
-    b.L = &L;
     double factor = rate > 0 ? hjc_tension_dif(m.hjc, rate) : std::nan("");
-    b.tension_factor = &factor;
-    S.p[0] = p;
-    S.s[0].setZero();
-    S.de[0].setZero();
-    S.de[0][5] = g;
-    st->update(b, S, m.shear_modulus());
-    return std::pair{S.yield[0], D};
+    const Sheared s = shear_with(*st, m, &L, &factor, p, 0, kSlow, 0, 0, g);
+    return std::pair{s.yield, s.D};
   };
   EXPECT_NEAR(sheared(-2e6, 1e-6, 100.0).first, 35.04334749902206e6, 1e-12 * 1e8);
   EXPECT_NEAR(sheared(-2e6, 1e-6, 1e-7).first, 18.96e6, 1e-12 * 1e8);
