@@ -131,8 +131,8 @@ class HjcEos final : public Eos {
                           double* K) const override {
     for (int i = 0; i < b.n; ++i) {
       set(i, b.rho[i], b.mu_max ? b.mu_max[i] : 0.0, A, B, K);
-      // The tension cut at -T (1 - D); T rate-dependent only where the cut of T itself (the
-      // least it can be) holds.
+      // The tension cut at -T (1 - D) times the rate factor (>= 1), which is worked out only
+      // where the cut without it would hold.
       const double cut = -curve_.h.T * (1.0 - (b.damage ? b.damage[i] : 0.0));
       if (A[i] < cut) A[i] = std::max(A[i], cut * dif_.of(b, i));
     }
