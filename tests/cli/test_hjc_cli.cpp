@@ -148,6 +148,15 @@ TEST(HjcCli, ExpandingCubeHoldsTheRateDependentTensionCut) {
     const fs::path scene = write(dir, "cube.toml", text);
     const Result r = prep_and_run(scene, "", dir / "cube.mpm", dir);
     EXPECT_EQ(r.status, 0) << r.err;
+    // mpm-prep says when the law is on, and what it gives.
+    const bool law = strength_keys.find("malvar-ross") != std::string::npos;
+    const bool capped = strength_keys.find("tension_dif_max") != std::string::npos;
+    const std::string says =
+        "tensile strength 4 MPa rising with the strain rate (Malvar-Ross for f'c 48 MPa): 5.68 "
+        "MPa at 1 /s, " +
+        std::string(capped ? "20 at 100 /s, 20 at 1000 /s, at most 20 MPa (x5)\n"
+                           : "26.36 at 100 /s, 56.8 at 1000 /s\n");
+    EXPECT_EQ(r.err.find(says) != std::string::npos, law) << r.err;
     const Result csv = run(
         post + " particles " + (dir / "cube.mpm").string() + " --columns x,sigma --digits 12", dir);
     EXPECT_EQ(csv.status, 0) << csv.err;

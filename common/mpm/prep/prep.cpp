@@ -26,6 +26,7 @@
 #include "mpm/prep/voxelise.hpp"
 #include "mpm/scene/particles.hpp"
 #include "mpm/solver/materials/material.hpp"
+#include "mpm/solver/materials/models.hpp"
 #include "mpm/stream/stream.hpp"
 
 namespace mpm {
@@ -253,6 +254,21 @@ void print_materials(const Scene& scene, double h_min) {
                  "step cfl h / c = %.4g ns\n",
                  spec.name.c_str(), c, spec.density, spec.youngs_modulus / 1e9,
                  scene.solver.cfl * h_min / c * 1e9);
+    // An opt-in rate law changes what the material is: say so, with what it gives.
+    if (spec.strength.model == StrengthModel::Hjc &&
+        spec.hjc.tension_rate == HjcSpec::TensionRate::MalvarRoss) {
+      const auto T_at = [&](double rate) {
+        return spec.hjc.T * hjc_tension_dif(spec.hjc, rate) / 1e6;
+      };
+      std::fprintf(stderr,
+                   "    tensile strength %.4g MPa rising with the strain rate (Malvar-Ross for f'c "
+                   "%.4g MPa): %.4g MPa at 1 /s, %.4g at 100 /s, %.4g at 1000 /s",
+                   spec.hjc.T / 1e6, spec.hjc.fc / 1e6, T_at(1.0), T_at(100.0), T_at(1000.0));
+      if (std::isfinite(spec.hjc.tension_dif_max))
+        std::fprintf(stderr, ", at most %.4g MPa (x%.4g)",
+                     spec.hjc.T * spec.hjc.tension_dif_max / 1e6, spec.hjc.tension_dif_max);
+      std::fprintf(stderr, "\n");
+    }
   }
 }
 
