@@ -254,9 +254,9 @@ void print_materials(const Scene& scene, double h_min) {
                  "step cfl h / c = %.4g ns\n",
                  spec.name.c_str(), c, spec.density, spec.youngs_modulus / 1e9,
                  scene.solver.cfl * h_min / c * 1e9);
-    // An opt-in rate law changes what the material is: say so, with what it gives.
-    if (spec.strength.model == StrengthModel::Hjc &&
-        spec.hjc.tension_rate == HjcSpec::TensionRate::MalvarRoss) {
+    // An opt-in rate law changes what the material is: say so, with what it gives (the reader
+    // takes tension_rate for HJC only).
+    if (spec.hjc.tension_rate == HjcSpec::TensionRate::MalvarRoss) {
       const auto T_at = [&](double rate) {
         return spec.hjc.T * hjc_tension_dif(spec.hjc, rate) / 1e6;
       };

@@ -167,9 +167,7 @@ class HjcStrength final : public Strength {
 
   bool needs_plastic_strain() const override { return true; }
   bool needs_pressure() const override { return true; }
-  bool rate_dependent_tension() const override {
-    return h_.tension_rate != HjcSpec::TensionRate::None;
-  }
+  bool rate_dependent_tension() const override { return dif_.on; }
 
   /// Normalised strength sigma* at P*, damage D, equivalent strain rate (1/s) and normalised
   /// tensile strength T*.
