@@ -1,6 +1,6 @@
 #pragma once
 // Runs a shell command for the CLI tests, capturing its exit status, stdout and stderr; reads
-// a result stream's history rows.
+// a result stream's history rows and mpm-post's CSV.
 #include <sys/wait.h>
 
 #include <cmath>
@@ -10,6 +10,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "mpm/stream/stream.hpp"
 
@@ -54,6 +55,49 @@ inline double json_value(const std::string& json, const std::string& key) {
   const std::regex re("\"" + key + "\": ([-0-9.eE+]+)");
   if (!std::regex_search(json, m, re)) return NAN;
   return std::stod(m[1]);
+}
+
+/// A CSV as mpm-post writes it: "#" comment lines (the frame's time, the units), a header of
+/// column names, rows of numbers. A cell that is not a number reads as NaN.
+struct Csv {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> rows;
+  /// The index of column `name`; -1 when there is none.
+  int col(const std::string& name) const {
+    for (std::size_t k = 0; k < names.size(); ++k)
+      if (names[k] == name) return int(k);
+    return -1;
+  }
+  /// Column `name` of every row (NaN where a row is short of it).
+  std::vector<double> column(const std::string& name) const {
+    const int k = col(name);
+    std::vector<double> v;
+    for (const auto& r : rows) v.push_back(k >= 0 && std::size_t(k) < r.size() ? r[k] : NAN);
+    return v;
+  }
+};
+
+inline Csv read_csv(const std::string& text) {
+  Csv t;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<std::string> cells;
+    std::istringstream f(line);
+    for (std::string cell; std::getline(f, cell, ',');) cells.push_back(cell);
+    if (t.names.empty()) {
+      t.names = std::move(cells);
+      continue;
+    }
+    std::vector<double> row;
+    for (const auto& c : cells) {
+      char* end = nullptr;
+      const double x = std::strtod(c.c_str(), &end);
+      row.push_back(end != c.c_str() && *end == '\0' ? x : NAN);
+    }
+    t.rows.push_back(std::move(row));
+  }
+  return t;
 }
 
 /// Appends a HIST record's rows to `all` (its names and units from the first record).

@@ -32,22 +32,15 @@ TEST(CliImplicit, RunsAndWritesItsWorkToTheHistory) {
           dir);
   ASSERT_EQ(r.status, 0) << r.err;
   // The per-row counts add up to the last row's total.
-  std::istringstream lines(r.out);
-  std::string line;
-  do std::getline(lines, line);  // the header, after the comment with the units
-  while (line.rfind('#', 0) == 0);
-  double sum = 0, total = 0, rows = 0;
-  while (std::getline(lines, line)) {
-    std::vector<double> v;
-    std::istringstream f(line);
-    std::string cell;
-    while (std::getline(f, cell, ',')) v.push_back(std::stod(cell));
+  const Csv csv = read_csv(r.out);
+  ASSERT_EQ(csv.names.size(), 8u);
+  double sum = 0, total = 0;
+  for (const auto& v : csv.rows) {
     ASSERT_EQ(v.size(), 8u);
     sum += v[4];
     total = v[7];
-    ++rows;
   }
-  EXPECT_GT(rows, 3);
+  EXPECT_GT(csv.rows.size(), 3u);
   EXPECT_GT(total, 0);
   EXPECT_EQ(sum, total);
 }

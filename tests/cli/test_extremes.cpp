@@ -44,23 +44,9 @@ Result run_scene(const fs::path& dir, const std::string& text) {
 /// leapfrog_total (the energy the guard watches, J) of the last and the first history rows.
 std::pair<double, double> energies(const fs::path& dir) {
   const Result h = run(post + " history " + (dir / "r.mpm").string(), dir);
-  std::istringstream in(h.out);
-  std::string header, line, first, last;
-  while (std::getline(in, header) && header.rfind("#", 0) == 0) {
-  }  // "# units: ..." comments
-  std::getline(in, first);
-  last = first;
-  while (std::getline(in, line))
-    if (!line.empty()) last = line;
-  int col = 0;
-  for (std::size_t p = 0, q; (q = header.find(',', p)) != std::string::npos; p = q + 1, ++col)
-    if (header.substr(p, q - p) == "leapfrog_total") break;
-  auto field = [&](const std::string& row) {
-    std::size_t p = 0;
-    for (int c = 0; c < col; ++c) p = row.find(',', p) + 1;
-    return std::stod(row.substr(p, row.find(',', p) - p));
-  };
-  return {field(last), field(first)};
+  const std::vector<double> e = read_csv(h.out).column("leapfrog_total");
+  if (e.empty()) return {NAN, NAN};
+  return {e.back(), e.front()};
 }
 
 // CFL 4 is four times the explicit limit: the run stops with exit 3 within a few steps, the

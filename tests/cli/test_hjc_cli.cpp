@@ -86,13 +86,8 @@ fs::path write(const fs::path& dir, const std::string& name, const std::string& 
 double column_max(const fs::path& result, const std::string& col, const fs::path& dir) {
   const Result r = run(post + " particles " + result.string() + " --columns " + col, dir);
   EXPECT_EQ(r.status, 0) << r.err;
-  std::istringstream in(r.out);
-  std::string line;
   double best = -1;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#' || !std::isdigit(line[0])) continue;
-    best = std::max(best, std::stod(line.substr(line.rfind(',') + 1)));
-  }
+  for (const double x : read_csv(r.out).column(col)) best = std::max(best, x);
   return best;
 }
 
@@ -160,19 +155,11 @@ TEST(HjcCli, ExpandingCubeHoldsTheRateDependentTensionCut) {
     const Result csv = run(
         post + " particles " + (dir / "cube.mpm").string() + " --columns x,sigma --digits 12", dir);
     EXPECT_EQ(csv.status, 0) << csv.err;
-    std::istringstream in(csv.out);
-    std::string line;
     double lo = 1e300, hi = -1e300;
     int n = 0;
-    while (std::getline(in, line)) {
-      if (line.empty() || !(std::isdigit(line[0]) || line[0] == '-')) continue;
-      std::istringstream row(line);
-      std::string cell;
-      double v[9];
-      for (double& x : v) {
-        std::getline(row, cell, ',');
-        x = std::stod(cell);
-      }
+    for (const auto& v : read_csv(csv.out).rows) {
+      EXPECT_EQ(v.size(), 9u);  // x_0..2, sigma_0..5
+      if (v.size() < 9) continue;
       if (v[0] > 5e-3 || v[1] > 5e-3 || v[2] > 5e-3) continue;
       EXPECT_EQ(v[3], v[4]);
       EXPECT_EQ(v[3], v[5]);

@@ -45,9 +45,9 @@ TEST(ManyBodies, FiveThousandCubesRunAndKeepTheirBodies) {
   const Result r = prep_and_run(dir / "grains.toml", "-q", dir / "out.mpm", dir);
   ASSERT_EQ(r.status, 0) << r.err;
   Frame first, last;
-  read_stream((dir / "out.mpm").string(), {.frame = [&](Frame&& fr) {
-                (first.columns.size() == 0 ? first : last) = std::move(fr);
-              }});
+  StreamVisitor v;
+  v.frame = [&](Frame&& fr) { (first.columns.size() == 0 ? first : last) = std::move(fr); };
+  read_stream((dir / "out.mpm").string(), v);
   ASSERT_EQ(first.columns.size(), std::size_t(n + 75 * 60));
   ASSERT_EQ(last.columns.size(), first.columns.size());
   const Column& body = last.columns.at("body");

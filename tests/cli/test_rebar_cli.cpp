@@ -72,24 +72,8 @@ TEST(RebarCli, BadRebarInputExits2NamingFileLineAndKey) {
 
 /// Rebar nodes (material 254) in a CSV of mpm-post particles.
 std::size_t rebar_nodes(const std::string& csv) {
-  std::istringstream in(csv);
-  std::string line;
-  std::vector<std::string> head;
-  int col = -1;
   std::size_t n = 0;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::vector<std::string> f;
-    std::stringstream s(line);
-    for (std::string x; std::getline(s, x, ',');) f.push_back(x);
-    if (col < 0) {
-      for (std::size_t k = 0; k < f.size(); ++k)
-        if (f[k] == "material") col = int(k);
-      if (col < 0) return 0;
-      continue;
-    }
-    n += std::size_t(col) < f.size() && f[col] == "254";
-  }
+  for (const double m : read_csv(csv).column("material")) n += m == 254;
   return n;
 }
 

@@ -17,25 +17,13 @@ namespace {
 using namespace mpm::testing;
 namespace fs = std::filesystem;
 
-/// Rows of a CSV with a header (lines starting with # skipped), by column name.
+/// Rows of mpm-post's CSV, by column name.
 std::vector<std::map<std::string, double>> csv(const std::string& text) {
-  std::istringstream in(text);
-  std::string line;
-  std::vector<std::string> names;
+  const Csv t = read_csv(text);
   std::vector<std::map<std::string, double>> rows;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream f(line);
-    std::string cell;
-    std::vector<std::string> cells;
-    while (std::getline(f, cell, ',')) cells.push_back(cell);
-    if (names.empty()) {
-      names = cells;
-      continue;
-    }
+  for (const auto& r : t.rows) {
     std::map<std::string, double> row;
-    for (std::size_t k = 0; k < cells.size() && k < names.size(); ++k)
-      row[names[k]] = std::stod(cells[k]);
+    for (std::size_t k = 0; k < r.size() && k < t.names.size(); ++k) row[t.names[k]] = r[k];
     rows.push_back(row);
   }
   return rows;

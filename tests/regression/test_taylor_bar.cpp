@@ -37,18 +37,7 @@ TEST(Regression, TaylorBarCoarse) {
   // The bar came to rest: the last history row's kinetic energy is a small part of the first's.
   r = run(post + " history " + out.string() + " --columns time,kinetic,leapfrog_total", dir);
   ASSERT_EQ(r.status, 0);
-  std::vector<std::vector<double>> rows;
-  std::istringstream lines(r.out);
-  std::string line;
-  do std::getline(lines, line);  // the header, after the comment with the units
-  while (line.rfind('#', 0) == 0);
-  while (std::getline(lines, line)) {
-    std::vector<double> v;
-    std::istringstream f(line);
-    std::string cell_text;
-    while (std::getline(f, cell_text, ',')) v.push_back(std::stod(cell_text));
-    rows.push_back(v);
-  }
+  const std::vector<std::vector<double>> rows = read_csv(r.out).rows;
   ASSERT_GT(rows.size(), 100u);
   EXPECT_LT(rows.back()[1], 0.02 * rows.front()[1]);
   // Energy: the leapfrog-consistent total (what the energy guard watches) is lost to the
