@@ -65,7 +65,7 @@ struct Points {
   Points whole() const {
     Points w;
     for (std::size_t i = 0; i < x.size(); ++i)
-      for (const Vec3 m : {Vec3(1, 1, 1), Vec3(-1, 1, 1), Vec3(1, -1, 1), Vec3(-1, -1, 1)})
+      for (const Vec3& m : {Vec3(1, 1, 1), Vec3(-1, 1, 1), Vec3(1, -1, 1), Vec3(-1, -1, 1)})
         w.x.push_back(x[i].cwiseProduct(m)), w.body.push_back(body[i]);
     return w;
   }

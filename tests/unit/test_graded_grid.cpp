@@ -231,7 +231,9 @@ void in_cell_matches_locate() {
     ASSERT_TRUE(g.in_cell(x, key, xi2)) << "point " << x.transpose();
     for (int a = 0; a < D; ++a) ASSERT_EQ(xi2[a], xi[a]);
     const std::int64_t other = (key + 1 + t % 7) % std::int64_t(g.key_count());
-    if (other != key) ASSERT_FALSE(g.in_cell(x, other, xi2));
+    if (other != key) {
+      ASSERT_FALSE(g.in_cell(x, other, xi2));
+    }
   }
 }
 
@@ -255,7 +257,9 @@ TEST(GradedGrid, LayersAreContiguousAndOnlyNeighbourLayersShareNodes) {
   const GradedGrid<3> g = nested<3>();
   std::vector<int> lo(g.nodes(), 1 << 30), hi(g.nodes(), -1);
   for (std::int64_t key = 0; key < std::int64_t(g.key_count()); ++key) {
-    if (key > 0) ASSERT_LE(g.layer(key - 1), g.layer(key));
+    if (key > 0) {
+      ASSERT_LE(g.layer(key - 1), g.layer(key));
+    }
     std::int64_t nodes[26];
     const int n = g.cell_nodes(key, nodes);
     for (int k = 0; k < n; ++k) {

@@ -32,6 +32,16 @@ MaterialSpec copper() {
   return m;
 }
 
+/// Copper's Mie-Grueneisen EOS (c0 3940 m/s, s 1.49, gamma0 1.96).
+EosSpec copper_mie_gruneisen() {
+  EosSpec e;
+  e.model = EosModel::MieGruneisen;
+  e.c0 = 3940.0;
+  e.s = 1.49;
+  e.gamma0 = 1.96;
+  return e;
+}
+
 /// The specific internal energy of the reference state (J/kg): the energy the EOS tests
 /// evaluate at (Mie-Grueneisen and linear ignore it).
 const double kCold = 0.0;
@@ -118,7 +128,9 @@ TEST(Materials, J2ReturnMappingFollowsTheAnalyticCurve) {
       const double q = von_mises(p.sigma);
       ASSERT_NEAR(q, q_exact, 1e-9 * q_exact + 1.0) << "n = " << n << ", step " << k;
       ASSERT_NEAR(trace(p.sigma), 0.0, 1e-6);
-      if (q_exact > A) ASSERT_NEAR(p.eps_p, eps - q_exact / (3 * G), 1e-9);
+      if (q_exact > A) {
+        ASSERT_NEAR(p.eps_p, eps - q_exact / (3 * G), 1e-9);
+      }
     }
     EXPECT_GT(p.eps_p, 0.15);  // deep in the plastic range
   }
@@ -173,7 +185,7 @@ TEST(Materials, J2UniaxialStressCurve) {
 TEST(Materials, EquationsOfStateMatchHandValues) {
   MaterialSpec spec = copper();
   spec.strength.model = StrengthModel::Elastic;
-  spec.eos = {EosModel::MieGruneisen, 3940.0, 1.49, 1.96};
+  spec.eos = copper_mie_gruneisen();
   const auto eos = model_registry().eos.at("mie-gruneisen")(spec);
   const double rho0 = 8930, c0 = 3940, s = 1.49, g0 = 1.96;
   for (double mu : {-0.05, 0.0, 0.02, 0.1, 0.3}) {
@@ -189,7 +201,9 @@ TEST(Materials, EquationsOfStateMatchHandValues) {
     }
     EXPECT_NEAR(A, pH, 1e-9 * std::abs(pH) + 1e-3) << "mu " << mu;
     EXPECT_DOUBLE_EQ(B, g0 * rho0);  // p = A + gamma0 E, E = rho0 e
-    if (mu == 0.0) EXPECT_NEAR(K, rho0 * c0 * c0, 1e-6 * rho0 * c0 * c0);
+    if (mu == 0.0) {
+      EXPECT_NEAR(K, rho0 * c0 * c0, 1e-6 * rho0 * c0 * c0);
+    }
   }
   // Stiffening: the bulk modulus grows with compression.
   double rho1 = rho0 * 1.1, rho2 = rho0 * 1.2, A, B, K1, K2;
@@ -211,7 +225,7 @@ TEST(Materials, EquationsOfStateMatchHandValues) {
 TEST(Materials, PressureWorkGoesIntoInternalEnergy) {
   MaterialSpec spec = copper();
   spec.strength.model = StrengthModel::Elastic;
-  spec.eos = {EosModel::MieGruneisen, 3940.0, 1.49, 1.96};
+  spec.eos = copper_mie_gruneisen();
   const Material mat(spec, no_viscosity());
   Point p(spec.density);
   const double rate = -1e4, dt = 1e-8;
@@ -235,7 +249,7 @@ TEST(Materials, PressureWorkGoesIntoInternalEnergy) {
 TEST(Materials, SignalSpeedIsTheIsentropicSoundSpeed) {
   MaterialSpec spec = copper();
   spec.strength.model = StrengthModel::Elastic;
-  spec.eos = {EosModel::MieGruneisen, 3940.0, 1.49, 1.96};
+  spec.eos = copper_mie_gruneisen();
   const Material mat(spec, no_viscosity());
   const double G = spec.youngs_modulus / (2 * (1 + spec.poisson_ratio));
   for (const double mu : {0.1, -0.2}) {
@@ -290,7 +304,7 @@ TEST(Materials, LinearEosSignalSpeedIsItsSoundSpeedAtAnyDensity) {
 // the isentropic bulk speed sqrt(K_s / rho).
 TEST(Materials, FailedPointsSignalSpeedHasNoShearAndNoExpansionBlowUp) {
   MaterialSpec spec = copper();
-  spec.eos = {EosModel::MieGruneisen, 3940.0, 1.49, 1.96};
+  spec.eos = copper_mie_gruneisen();
   spec.failure.pressure = -100e6;
   const Material mat(spec, no_viscosity());
   const double c_bulk0 = 3940.0;  // sqrt(K(rho0) / rho0) of this EOS: c0

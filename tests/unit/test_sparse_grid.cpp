@@ -96,7 +96,7 @@ TEST(SparseGrid, KeysInDenseOrderAndSharedCorners) {
       ASSERT_EQ(ki < kj, di < dj);
       ASSERT_EQ(g.layer(ki), dense.layer(di));
     }
-  std::int64_t key, nodes[8], next[8];
+  std::int64_t key = -1, nodes[8], next[8];
   Vec3 xi;
   ASSERT_EQ(g.where(x[100], key, xi), Where::Window);
   g.cell_nodes(key, nodes);
@@ -105,7 +105,9 @@ TEST(SparseGrid, KeysInDenseOrderAndSharedCorners) {
   ASSERT_EQ(g.where(x[100] + Vec3(0.5, 0, 0), key_x, xi), Where::Window);  // the cell on +x
   g.cell_nodes(key_x, next);
   for (int c = 0; c < 8; ++c)
-    if (!(c & 1)) EXPECT_EQ(next[c], nodes[c | 1]);  // its -x face is our +x face
+    if (!(c & 1)) {
+      EXPECT_EQ(next[c], nodes[c | 1]);  // its -x face is our +x face
+    }
 }
 
 // Nodes on constrained faces: only the active ones, with the face they lie on.
@@ -142,9 +144,10 @@ TEST(CellLattice, InCellIsLocateBitForBit) {
       Vec3 xi;
       const bool in = g.in_cell(c, x, xi);
       EXPECT_EQ(in, dc == 0) << "x = " << x.transpose() << ", cell offset " << dc;
-      if (dc == 0)
+      if (dc == 0) {
         for (int a = 0; a < 3; ++a)
           EXPECT_EQ(std::bit_cast<std::uint64_t>(xi[a]), std::bit_cast<std::uint64_t>(xi_loc[a]));
+      }
       out += !in;
     }
     ++points;

@@ -97,7 +97,9 @@ void check_mask(std::uint32_t mask, std::mt19937& rng, int random_points) {
       if (!at_node) continue;
       EXPECT_NEAR(N[k], 1.0, 1e-14) << "mask " << mask << " node " << k;
       for (int j = 0; j < n; ++j) {
-        if (j != k) EXPECT_NEAR(N[j], 0.0, 1e-14) << "mask " << mask;
+        if (j != k) {
+          EXPECT_NEAR(N[j], 0.0, 1e-14) << "mask " << mask;
+        }
       }
     }
     int a = 0;

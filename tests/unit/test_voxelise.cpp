@@ -884,7 +884,7 @@ TEST(Voxelise, RefusesBadShapesAndOverlappingBodies) {
   // 256 spheres in one place are refused for their overlap, not their number.
   s.bodies.clear();
   for (int i = 0; i < 256; ++i) {
-    char name[8];  // (not "b" + std::to_string(i): GCC 12 warns falsely with -Wrestrict)
+    char name[16];  // (not "b" + std::to_string(i): GCC 12 warns falsely with -Wrestrict)
     std::snprintf(name, sizeof name, "b%d", i);
     s.bodies.push_back(sphere(name, 0.2, Vec3::Ones() * 0.5));
   }

@@ -95,8 +95,11 @@ TEST(Rigid, PushedBlockMomentumBalancesTheRigidForce) {
       << dp.transpose() << " vs " << impulse.transpose();
   // Rigid particles kept their velocity and moved with it.
   auto p = view<3>(cols);
-  for (std::size_t i = 0; i < p.n; ++i)
-    if (p.material[i] == kRigidMaterial) ASSERT_EQ(p.v[i], pusher.velocity);
+  for (std::size_t i = 0; i < p.n; ++i) {
+    if (p.material[i] == kRigidMaterial) {
+      ASSERT_EQ(p.v[i], pusher.velocity);
+    }
+  }
   EXPECT_EQ(solver.rigid_force()[0].norm(), 0.0);  // body 0 is not rigid
 }
 
