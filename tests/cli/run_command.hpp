@@ -77,6 +77,7 @@ struct Csv {
   }
 };
 
+/// `text` (mpm-post's stdout) read as a Csv.
 inline Csv read_csv(const std::string& text) {
   Csv t;
   std::istringstream in(text);
