@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "mpm/stream/stream.hpp"
 #include "run_command.hpp"
