@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <map>
 #include <string>
 #include <utility>
 
@@ -177,6 +180,70 @@ TEST(HjcCli, ExpandingCubeHoldsTheRateDependentTensionCut) {
   EXPECT_NEAR(capped.second, 20e6, 5.0);
 }
 
+// The averaged damage (damage_length, docs/scene.md) on the crushed cube: at the cell size
+// (2 mm: 8 particles a lattice cell) and at 6 mm (three cells) the damage evens out more the
+// longer the length, each run the same at one and two threads, bit for bit (a particle alone
+// in its lattice cell keeps its own increment: tests/unit/test_damage_average.cpp).
+TEST(HjcCli, AveragedDamageEvensOutWithItsLengthWhateverTheThreads) {
+  const auto dir = temp_dir("hjc_nonlocal");
+  // Damage by particle id after a run with `keys` added to the strength table.
+  const auto damage = [&](const std::string& keys, const std::string& threads) {
+    std::string text = kCube;
+    const std::string at = "EF_min = 0.01\n";
+    text.replace(text.find(at), at.size(), at + keys);
+    const fs::path scene = write(dir, "cube.toml", text);
+    const Result r =
+        run(prep + " " + scene.string() + " | " + runner + " --progress none --threads " + threads +
+                " -o " + (dir / "cube.mpm").string(),
+            dir);
+    EXPECT_EQ(r.status, 0) << r.err;
+    if (!keys.empty())  // mpm-prep says the damage is averaged, and over what
+      EXPECT_NE(r.err.find(keys == "damage_length = \"2 mm\"\n"
+                               ? "damage increments averaged over 2 mm (1 finest cells; "
+                                 "reaching at most 4 mm each way)"
+                               : "damage increments averaged over 6 mm (3 finest cells; "
+                                 "reaching at most 12 mm each way)"),
+                std::string::npos)
+          << r.err;
+    const Result csv = run(post + " particles " + (dir / "cube.mpm").string() +
+                               " --columns id,body,damage --digits 17",
+                           dir);
+    EXPECT_EQ(csv.status, 0) << csv.err;
+    std::map<long, double> by_id;
+    for (const auto& v : read_csv(csv.out).rows)
+      if (v.size() >= 3 && v[1] == 0) by_id[long(v[0])] = v[2];  // the cube's (body 0)
+    return by_id;
+  };
+  const auto local = damage("", "1");
+  const auto cell = damage("damage_length = \"2 mm\"\n", "1");
+  const auto wide = damage("damage_length = \"6 mm\"\n", "1");
+  const auto wide2 = damage("damage_length = \"6 mm\"\n", "2");
+  for (const auto& [id, D] : wide) EXPECT_EQ(wide2.at(id), D) << id;  // bitwise
+  // The averaged increments keep their mass-weighted sum each step (damage_average.hpp; the
+  // cube's particles have equal masses), so the mean damage moves only through the feedback
+  // of a slightly different field (2e-5 here); the spread over the particles (standard
+  // deviation about the mean) shrinks (to 0.53 of the local one: the crushing is nearly uniform,
+  // the spread is the platen's edge and the free faces').
+  const auto spread = [](const std::map<long, double>& d, double& mean) {
+    double s = 0, s2 = 0;
+    for (const auto& [id, D] : d) s += D, s2 += D * D;
+    mean = s / double(d.size());
+    return std::sqrt(std::max(0.0, s2 / double(d.size()) - mean * mean));
+  };
+  double mean_local, mean_cell, mean_wide;
+  const double sd_local = spread(local, mean_local), sd_cell = spread(cell, mean_cell),
+               sd_wide = spread(wide, mean_wide);
+  std::printf("damage: local mean %.6g sd %.4g; 2 mm %.6g %.4g; 6 mm %.6g %.4g\n", mean_local,
+              sd_local, mean_cell, sd_cell, mean_wide, sd_wide);
+  ASSERT_EQ(local.size(), 1000u);
+  ASSERT_GT(mean_local, 0.1);
+  EXPECT_NEAR(mean_cell, mean_local, 1e-3 * mean_local);
+  EXPECT_NEAR(mean_wide, mean_local, 1e-3 * mean_local);
+  EXPECT_LT(sd_cell, sd_local);
+  EXPECT_LT(sd_wide, 0.75 * sd_local);
+  EXPECT_LT(sd_wide, sd_cell);
+}
+
 TEST(HjcCli, BadHjcInputExitsTwo) {
   const auto dir = temp_dir("hjc_bad");
   struct Case {
@@ -200,6 +267,13 @@ TEST(HjcCli, BadHjcInputExitsTwo) {
       {"EF_min = 0.01\n", "EF_min = 0.01\ntension_dif_max = 8\n",
        "bad.toml:16: materials.concrete.strength.tension_dif_max: caps the rate law of "
        "tension_rate; set tension_rate = \"malvar-ross\" too"},
+      {"EF_min = 0.01\n", "EF_min = 0.01\ndamage_length = \"0 mm\"\n",
+       "bad.toml:16: materials.concrete.strength.damage_length: must be > 0"},
+      {"EF_min = 0.01\n", "EF_min = 0.01\ndamage_length = \"4 MPa\"\n",
+       "bad.toml:16: materials.concrete.strength.damage_length:"},
+      {"EF_min = 0.01\n", "EF_min = 0.01\ndamage_length = \"1 mm\"\n",
+       "bad.toml:16: materials.concrete.strength.damage_length: expected at least the finest "
+       "cell, 2 mm (a few cells for the average to act), got 1 mm"},
   };
   for (const auto& c : cases) {
     std::string text = kCube;

@@ -217,6 +217,14 @@ TEST(Mpi, RigidPlatenAcrossTheCutMatchesOneProcess) {
   check_ranks("platen", kData + "platen.toml", "");
 }
 
+// HJC concrete with its damage averaged over 6 mm (damage_length): the damaging particles'
+// lattice box agreed between the ranks and the lattice's sums added across them, so each
+// particle's damage is one process's to round-off.
+TEST(Mpi, AveragedDamageAcrossTheCutMatchesOneProcess) {
+  if (!have_mpi()) GTEST_SKIP() << "built without MPI (MPM_MPI off) or no mpirun";
+  check_ranks("hjc_nonlocal", kData + "hjc_nonlocal.toml", "");
+}
+
 // A particle that leaves the domain with solver.on_exit = "stop" stops every rank: exit 5, the
 // stream ended by the root with that status and the frames before it intact, as one process.
 TEST(Mpi, ParticleLeavingTheDomainStopsEveryRank) {

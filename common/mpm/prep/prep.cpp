@@ -269,6 +269,12 @@ void print_materials(const Scene& scene, double h_min) {
                      spec.hjc.T * spec.hjc.tension_dif_max / 1e6, spec.hjc.tension_dif_max);
       std::fprintf(stderr, "\n");
     }
+    if (spec.strength.model == StrengthModel::Hjc && spec.hjc.damage_length > 0)
+      std::fprintf(stderr,
+                   "    damage increments averaged over %.4g mm (%.3g finest cells; reaching at "
+                   "most %.4g mm each way)\n",
+                   spec.hjc.damage_length * 1e3, spec.hjc.damage_length / h_min,
+                   2e3 * spec.hjc.damage_length);
   }
 }
 

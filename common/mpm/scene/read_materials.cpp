@@ -12,8 +12,16 @@ namespace mpm::scene_toml {
 
 namespace {
 
-const std::initializer_list<std::string_view> kHjcStrengthKeys = {
-    "N", "fc", "T", "S_max", "D1", "D2", "EF_min", "tension_rate", "tension_dif_max"};
+const std::initializer_list<std::string_view> kHjcStrengthKeys = {"N",
+                                                                  "fc",
+                                                                  "T",
+                                                                  "S_max",
+                                                                  "D1",
+                                                                  "D2",
+                                                                  "EF_min",
+                                                                  "tension_rate",
+                                                                  "tension_dif_max",
+                                                                  "damage_length"};
 
 // HJC strength and damage (Holmquist, Johnson & Cook 1993); the constants of 004 Table 4 are
 // the examples.
@@ -21,7 +29,7 @@ void read_hjc_strength(Reader& r, HjcSpec& h) {
   r.reject({"n", "m", "room_temperature", "melt_temperature", "specific_heat", "taylor_quinney",
             "yield_stress", "tangent_modulus"},
            "by the hjc model (its keys: A, B, N, C, fc, T, S_max, reference_rate, D1, D2, EF_min, "
-           "tension_rate, tension_dif_max)");
+           "tension_rate, tension_dif_max, damage_length)");
   h.A = r.required("A", dim::none, Bound::NonNegative, "0.79", "normalised cohesion");
   h.B = r.required("B", dim::none, Bound::NonNegative, "1.60", "normalised pressure hardening");
   h.N = r.required("N", dim::none, Bound::Positive, "0.61", "pressure hardening exponent");
@@ -48,6 +56,9 @@ void read_hjc_strength(Reader& r, HjcSpec& h) {
             "caps the rate law of tension_rate; set tension_rate = \"malvar-ross\" too");
     h.tension_dif_max = *cap;
   }
+  // Opt-in: the damage increments averaged over a length (docs/scene.md, HJC concrete).
+  h.damage_length = r.quantity("damage_length", dim::length, Bound::Positive).value_or(0.0);
+  h.damage_length_loc = r.loc_of("damage_length");
   r.finish();
 }
 
@@ -323,7 +334,8 @@ MaterialSpec read_material(Reader& r, const std::string& name, std::vector<std::
                                     "D2",
                                     "EF_min",
                                     "tension_rate",
-                                    "tension_dif_max"})) {
+                                    "tension_dif_max",
+                                    "damage_length"})) {
     read_strength(*t, m.strength, m.hjc);
     const bool bilinear = m.strength.model == StrengthModel::Bilinear;
     yield_at = t->loc_of(bilinear ? "yield_stress" : "A");

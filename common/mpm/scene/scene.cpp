@@ -16,6 +16,7 @@
 #include <system_error>
 
 #include "mpm/core/error.hpp"
+#include "mpm/core/units.hpp"
 #include "mpm/scene/overrides.hpp"
 #include "mpm/scene/read_sections.hpp"
 #include "mpm/scene/toml_reader.hpp"
@@ -62,6 +63,23 @@ void check_axisymmetric(const Scene& s) {
                      "(no radial velocity on the axis)");
 }
 
+/// HJC's damage_length (docs/scene.md) is at least the finest cell: shorter, each particle's
+/// increment would stay in its own cell (the damage local) while its lattice grew as
+/// (extent / l)^D nodes.
+void check_damage_length(const Scene& s) {
+  const double finest = s.grid.cell_size / double(1 << (s.grid.level_count() - 1));
+  for (const MaterialSpec& m : s.materials) {
+    const HjcSpec& h = m.hjc;
+    if (m.strength.model != StrengthModel::Hjc || h.damage_length <= 0) continue;
+    if (h.damage_length < finest * (1 - 1e-9))
+      throw InputError(
+          where(h.damage_length_loc.file, h.damage_length_loc.line, h.damage_length_loc.key),
+          "expected at least the finest cell, " + format_mm(finest) +
+              " mm (a few cells for the average to act), got " + format_mm(h.damage_length) +
+              " mm");
+  }
+}
+
 void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
   Reader top(doc, root, "", Origin{},
              {"scene", "materials", "bodies", "loads", "contact", "grid", "boundary", "solver",
@@ -80,6 +98,7 @@ void read_scene(const Doc& doc, const toml::table& root, Scene& s) {
     read_grid(g, s);
   }
   check_particle_spacing(s);
+  check_damage_length(s);
   if (auto b =
           top.table("boundary", {"all", "x_min", "x_max", "y_min", "y_max", "z_min", "z_max"})) {
     read_boundary(*b, s);

@@ -95,6 +95,11 @@ struct HjcSpec {
   enum class TensionRate : std::uint8_t { None, MalvarRoss };
   TensionRate tension_rate = TensionRate::None;
   double tension_dif_max = std::numeric_limits<double>::infinity();
+  /// m; 0: the damage of each particle from its own strains (as published). Else each step's
+  /// damage increments are averaged, weighted by mass, over about this length each way (a
+  /// lattice of this spacing, common/mpm/solver/damage_average.hpp) before they are added.
+  double damage_length = 0;
+  SourceLoc damage_length_loc;  ///< where damage_length was given (file line or --set)
   double K_elastic() const { return P_crush / mu_crush; }
 };
 

@@ -218,7 +218,7 @@ class SolverCore {
   /// trial copy of the state), velocity gradients in scr.L (with `rows` in scr.L_rows, one
   /// component an array); returns the block (signal speeds in scr.c, faults).
   MaterialBlock update_block(const PendingBlock& pb, const ParticleView<D>& s, StressScratch& scr,
-                             bool rows = false) const;
+                             bool rows = false, double* damage_increment = nullptr) const;
   /// Books the force F (N) the material exerts on rigid body `body` along `axis` in a step
   /// and the work the body does on the material.
   void book_rigid_force(int body, int axis, double F) {
@@ -451,7 +451,8 @@ void SolverCore<GridT>::reduce(const std::vector<ChunkSums>& chunks, ChunkSums& 
 
 template <Grid GridT>
 MaterialBlock SolverCore<GridT>::update_block(const PendingBlock& pb, const ParticleView<D>& s,
-                                              StressScratch& scr, bool rows) const {
+                                              StressScratch& scr, bool rows,
+                                              double* damage_increment) const {
   MaterialBlock blk;
   blk.n = pb.k;
   blk.dt = dt_;
@@ -463,6 +464,7 @@ MaterialBlock SolverCore<GridT>::update_block(const PendingBlock& pb, const Part
   blk.m = s.m + pb.i0;
   blk.set_state(s.sigma, s.rho, s.e, s.eps_p, s.T, s.failed, s.thickness, pb.i0);
   blk.set_history(s.damage, s.mu_max, pb.i0);
+  blk.damage_increment = damage_increment;
   blk.c = scr.c;
   blk.plane_stress = plane_stress_;
   materials_[pb.mat].update(blk, scr.S);

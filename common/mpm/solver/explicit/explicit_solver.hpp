@@ -103,6 +103,7 @@ class ExplicitSolver : public SolverCore<GridT> {
   template <G2pMode M>
   void g2p();
   void update_stress(const std::vector<Vec<D>>& v_grad, Positions positions);
+  void average_damage();  ///< HJC with damage_length: the step's increments averaged, added
   void exchange_momentum(Exchange on);
   void split_particles() requires GridT::kGraded;
   void rebar_forces();
@@ -293,6 +294,12 @@ class ExplicitSolver : public SolverCore<GridT> {
   std::uint32_t next_id_ = 0;    ///< id of the next particle a split creates (0: not yet known)
   long split_count_ = 0;         ///< particles split so far
   int split_wait_ = 0;           ///< steps the pending splits have waited for a sort
+  /// HJC materials with a damage_length (damage_average.hpp): their indices, a flag by
+  /// material, the step's local increments by particle, and the lattice's scratch.
+  std::vector<int> averaged_;
+  std::vector<std::uint8_t> averaged_by_mat_;
+  mutable std::vector<double> damage_increment_;
+  std::vector<double> lattice_q_, lattice_m_;
 };
 
 /// The uniform-grid solver of a scene: builds the window grid on the scene's lattice.

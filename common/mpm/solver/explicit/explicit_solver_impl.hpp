@@ -85,6 +85,11 @@ ExplicitSolver<GridT>::ExplicitSolver(const Scene& scene, GridT grid, ColumnStor
     throw InputError("--strategy",
                      "a scene with [[contact]] needs the colored (default) or "
                      "lr-slabs strategy: the bodies' fields have no private copies");
+  averaged_by_mat_.assign(materials_.size(), 0);
+  for (std::size_t k = 0; k < materials_.size(); ++k)
+    if (materials_[k].spec().strength.model == StrengthModel::Hjc &&
+        materials_[k].spec().hjc.damage_length > 0)
+      averaged_.push_back(int(k)), averaged_by_mat_[k] = 1;
   sort_particles();
   stable_dt_ = this->start_energies();  // initial energies and the first stable time step
 }

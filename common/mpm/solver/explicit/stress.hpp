@@ -6,6 +6,7 @@
 
 #include <algorithm>
 
+#include "mpm/solver/damage_average.hpp"
 #include "mpm/solver/explicit/explicit_solver.hpp"
 
 namespace mpm {
@@ -18,6 +19,7 @@ void ExplicitSolver<GridT>::update_stress(const std::vector<Vec<D>>& v_grad, Pos
   const int nchunks = binning_.chunk_count();
   std::vector<ChunkSums> stats(nchunks);
   const bool remapped = &v_grad == &grid_.v_remap;  // MUSL: the fields' remapped velocities
+  if (!averaged_.empty()) damage_increment_.assign(p.n, 0.0);  // none where no update wrote
   if (contact_.active()) {
 #pragma omp parallel for schedule(dynamic, 1)
     for (int ch = 0; ch < nchunks; ++ch)
@@ -28,6 +30,28 @@ void ExplicitSolver<GridT>::update_stress(const std::vector<Vec<D>>& v_grad, Pos
       stress_chunk<false>(p, ch, v_grad.data(), positions, remapped, stats[ch]);
   }
   finish(stats, positions == Positions::Move ? kStresses | kPositions : kStresses);
+  if (!averaged_.empty()) average_damage();
+}
+
+/// The damage increments of the HJC materials with a damage_length, averaged over it and
+/// added to their damage (damage_average.hpp): the damage of t^(n+1), which the next step's
+/// strength and tension cut read.
+template <Grid GridT>
+void ExplicitSolver<GridT>::average_damage() {
+  ScopedTimer timer(timers_, timers_.id("damage_average"));
+  const ParticleView<D> p = view<D>(particles_);
+  for (int mat : averaged_) {
+    DamageAverageInput<D> in;
+    in.n = p.n;
+    in.x = p.x;
+    in.m = p.m;
+    in.material = p.material;
+    in.mat = mat;
+    in.length = materials_[mat].spec().hjc.damage_length;
+    in.increment = damage_increment_.data();
+    in.damage = p.damage;
+    mpm::average_damage<D>(in, ranks_ ? &Comm::world() : nullptr, lattice_q_, lattice_m_);
+  }
 }
 
 /// The stress update of the particles of chunk ch from the grid velocities vg_i (flattened:
@@ -298,7 +322,8 @@ void ExplicitSolver<GridT>::stress_block(const ParticleView<D>& p, PendingBlock&
                                          StressScratch& scr, ChunkSums& s, bool rows,
                                          bool motion) const {
   if (pb.k == 0) return;
-  const MaterialBlock blk = update_block(pb, p, scr, rows);
+  const MaterialBlock blk = update_block(
+      pb, p, scr, rows, averaged_by_mat_[pb.mat] ? damage_increment_.data() + pb.i0 : nullptr);
   // In registers, not through s: the block's internal energy, and its fastest signal
   // (min_j h / s_j is h / max_j s_j exactly: a division is monotone, one is enough); partial
   // sums and maxima a vector of particles at a time (in a fixed order: the same bits each run).

@@ -157,7 +157,8 @@ class HjcEos final : public Eos {
 /// equivalent deviatoric strain rate. Radial return at the flow stress of the step's start
 /// (pressure at the new density, damage of t^n), then damage D += (d eps_p + d mu_p) / eps_f,
 /// eps_f = max(EF_min, D1 (P* + T*)^D2), D <= 1, with mu_p the plastic volumetric strain of
-/// the crushing (HjcPressure::plastic_volumetric_strain). With a rate-dependent tensile strength
+/// the crushing (HjcPressure::plastic_volumetric_strain); with a damage_length the increment
+/// goes to b.damage_increment, for the solver to average. With a rate-dependent tensile strength
 /// T* is T hjc_tension_dif(rate_1) / f'c in the tension branch and the fracture strain, rate_1
 /// the largest principal strain rate (the EOS cuts at the same T).
 class HjcStrength final : public Strength {
@@ -218,10 +219,13 @@ class HjcStrength final : public Strength {
           b.mu_max[i] = mu;
         }
       }
-      if (b.damage && dl + dmu_p > 0) {
-        D += (dl + dmu_p) / fracture_strain(P_star, T_star_ * dif_.of(b, i));
-        b.damage[i] = std::min(D, 1.0);
-      }
+      const double dD = b.damage && dl + dmu_p > 0
+                            ? (dl + dmu_p) / fracture_strain(P_star, T_star_ * dif_.of(b, i))
+                            : 0.0;
+      if (b.damage_increment)
+        b.damage_increment[i] = dD;  // averaged over damage_length by the solver
+      else if (dD > 0)
+        b.damage[i] = std::min(D + dD, 1.0);
     }
   }
 

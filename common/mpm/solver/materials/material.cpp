@@ -302,7 +302,7 @@ void Material::update_iterating(MaterialBlock& b, PlaneStressIteration& it, cons
                                 BlockScratch& S) const {
   Sym g_sigma[kBlock];
   double g_rho[kBlock], g_e[kBlock], g_ep[kBlock], g_T[kBlock], g_m[kBlock], g_c[kBlock];
-  double g_D[kBlock], g_mm[kBlock];
+  double g_D[kBlock], g_mm[kBlock], g_dD[kBlock];
   std::uint8_t g_f[kBlock];
   Mat3 g_L[kBlock];
   MaterialBlock g = b;
@@ -312,6 +312,7 @@ void Material::update_iterating(MaterialBlock& b, PlaneStressIteration& it, cons
   g.set_state(g_sigma, g_rho, g_e, b.eps_p ? g_ep : nullptr, b.T ? g_T : nullptr,
               b.failed ? g_f : nullptr, nullptr, 0);
   g.set_history(b.damage ? g_D : nullptr, b.mu_max ? g_mm : nullptr, 0);
+  g.damage_increment = b.damage_increment ? g_dD : nullptr;
   g.c = g_c;
   g.fault_index = -1;
   g.fault = PointFault::None;
@@ -329,6 +330,7 @@ void Material::update_iterating(MaterialBlock& b, PlaneStressIteration& it, cons
     const int i = idx[j];
     copy_state(g, j, b, i);
     b.c[i] = g_c[j];
+    if (b.damage_increment) b.damage_increment[i] = g_dD[j];
   }
 }
 

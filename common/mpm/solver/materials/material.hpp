@@ -52,7 +52,11 @@ struct MaterialBlock {
   std::uint8_t* failed = nullptr;  ///< failure flag (in/out; nullptr if absent)
   double* damage = nullptr;        ///< HJC damage D (in/out; nullptr if absent)
   double* mu_max = nullptr;        ///< HJC largest compression rho/rho0 - 1 (in/out; or nullptr)
-  double* c = nullptr;             ///< out: signal speed for the time step, m/s
+  /// HJC with a damage_length: out, this step's local damage increment per particle, which the
+  /// solver averages before adding it to `damage` (damage_average.hpp); damage stays that of
+  /// t^n. Null: the update adds its increment to `damage` itself.
+  double* damage_increment = nullptr;
+  double* c = nullptr;  ///< out: signal speed for the time step, m/s
   /// The factor on a rate-dependent tensile strength this step (HJC's T), per particle: NaN
   /// until the model works it out from L, for the particles that need it (in tension, or
   /// damaging), and kept for the rest of the step. Set by the update for a strength that has
