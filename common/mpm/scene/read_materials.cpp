@@ -313,29 +313,22 @@ MaterialSpec read_material(Reader& r, const std::string& name, std::vector<std::
             "must be below 0.5 (incompressible materials are not supported)");
   }
   SourceLoc yield_at, c0_at;
-  if (auto t = r.table("strength", {"model",
-                                    "A",
-                                    "B",
-                                    "n",
-                                    "C",
-                                    "reference_rate",
-                                    "m",
-                                    "room_temperature",
-                                    "melt_temperature",
-                                    "specific_heat",
-                                    "taylor_quinney",
-                                    "yield_stress",
-                                    "tangent_modulus",
-                                    "N",
-                                    "fc",
-                                    "T",
-                                    "S_max",
-                                    "D1",
-                                    "D2",
-                                    "EF_min",
-                                    "tension_rate",
-                                    "tension_dif_max",
-                                    "damage_length"})) {
+  // The strength table takes the keys of every model; each model's reader refuses the others'.
+  std::vector<std::string_view> strength_keys = {"model",
+                                                 "A",
+                                                 "B",
+                                                 "n",
+                                                 "C",
+                                                 "reference_rate",
+                                                 "m",
+                                                 "room_temperature",
+                                                 "melt_temperature",
+                                                 "specific_heat",
+                                                 "taylor_quinney",
+                                                 "yield_stress",
+                                                 "tangent_modulus"};
+  strength_keys.insert(strength_keys.end(), kHjcStrengthKeys);
+  if (auto t = r.table("strength", strength_keys)) {
     read_strength(*t, m.strength, m.hjc);
     const bool bilinear = m.strength.model == StrengthModel::Bilinear;
     yield_at = t->loc_of(bilinear ? "yield_stress" : "A");
