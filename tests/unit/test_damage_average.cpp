@@ -70,7 +70,9 @@ TEST(DamageAverage, KeepsTheMassWeightedSumOfTheIncrements) {
   for (std::size_t i = 0; i < c.x.size(); ++i) {
     band += c.dD[i] > 0;
     damaged += c.D[i] > 0;
-    if (c.D[i] > 0) EXPECT_LT(std::abs(c.x[i][0] - 1e-3), 0.6e-3 + 4e-3 + 1e-12);
+    if (c.D[i] > 0) {
+      EXPECT_LT(std::abs(c.x[i][0] - 1e-3), 0.6e-3 + 4e-3 + 1e-12);
+    }
   }
   EXPECT_GT(damaged, 2 * band);
 }
@@ -116,8 +118,9 @@ TEST(DamageAverage, APointSpreadsOverTwiceTheLengthAndLeavesOtherMaterialsAlone)
       continue;
     }
     total += c.m[i] * c.D[i];
-    if (c.D[i] > 0)
+    if (c.D[i] > 0) {
       for (int a = 0; a < 3; ++a) EXPECT_LT(std::abs(c.x[i][a] - c.x[src][a]), 2 * l);
+    }
     if (i == src) kept = c.D[i];
   }
   EXPECT_NEAR(total, c.m[src] * 0.5, 1e-12 * c.m[src]);
@@ -157,7 +160,9 @@ TEST(DamageAverage, WorksInTwoDimensions) {
   EXPECT_NEAR(after, before, 1e-12 * before);
   // The column of particles at i = 10 spreads across x only: D depends on i alone.
   for (std::size_t k = 0; k + 30 < x.size(); ++k)
-    if (k % 30 != 29) EXPECT_NEAR(D[k], D[k + 1], 1e-15);
+    if (k % 30 != 29) {
+      EXPECT_NEAR(D[k], D[k + 1], 1e-15);
+    }
 }
 
 }  // namespace
