@@ -13,15 +13,17 @@
 /// spreads over at most 2 l each way (a tent of half-width l, scattered and gathered). Near a
 /// free surface or a symmetry plane the mean is over the material there (the ratio has no
 /// missing-mirror bias). Only the lattice's bounding box of the particles that damaged this
-/// step is stored (dense), so the cost is one pass over the material's particles plus the
-/// damaging zone. The scatter runs serially in particle order (the same bits for any thread
-/// count); under mpirun the box is agreed between the ranks and the lattice summed across them.
+/// step is stored (dense), so the cost is three passes over the particles (the box, the
+/// scatter, the gather) plus the damaging zone's nodes. The scatter runs serially in particle order
+/// (the same bits for any thread count); under mpirun the box is agreed between the ranks and the
+/// lattice summed across them.
 #include <omp.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "mpm/core/comm.hpp"
@@ -44,7 +46,7 @@ struct DamageAverageInput {
 
 /// Averages the increments of material `in.mat` and adds them to its damage (capped at 1).
 /// `comm` is null or the ranks of an mpirun (every rank calls it). Returns the lattice nodes
-/// used (0 when no particle damaged), for the kernel's report.
+/// used (0 when no particle damaged this step).
 template <int D>
 std::size_t average_damage(const DamageAverageInput<D>& in, const Comm* comm,
                            std::vector<double>& Q, std::vector<double>& M) {
