@@ -147,9 +147,11 @@ class GradedGrid {
   int layer(std::int64_t key) const { return cells_[key].layer; }
   int layers() const { return wn_[slab_]; }
   int slab_axis() const { return slab_; }
-  /// Length scale of the time step and the bulk viscosity (m): the finest cell's everywhere,
-  /// since the time step must hold for the finest cells (004, section 3.4).
-  double cell_size(std::int64_t) const { return level_[levels_].h; }
+  /// Size of a cell (m): its level's. The length of the bulk viscosity of the particles in it
+  /// (a shock is spread over the cells it crosses, so its viscosity scales with them).
+  double cell_size(std::int64_t key) const { return level_[cells_[key].level].h; }
+  /// The finest cell's size (m): the length of the time step, which must hold for the finest
+  /// cells (004, section 3.4).
   double min_cell_size() const { return level_[levels_].h; }
   /// The size of the largest cell a node's shape function spans (m): its level's cells inside
   /// a level, the coarser cells' on a level interface (hanging nodes included). What a

@@ -457,6 +457,7 @@ MaterialBlock SolverCore<GridT>::update_block(const PendingBlock& pb, const Part
   blk.n = pb.k;
   blk.dt = dt_;
   blk.h = pb.h;
+  blk.h_step = grid_.min_cell_size();
   if (rows)
     blk.L_rows = scr.L_rows;
   else

@@ -438,6 +438,7 @@ void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
     }
   const double G43 = 4.0 / 3.0 * G_, c2_rest = K0_eos_ / spec_.density;
   const double yield_none = no_flow_stress(G_);
+  const double h_step = b.h_step > 0 ? b.h_step : b.h;
   for (int i = 0; i < n; ++i) {
     const double rho = b.rho[i], P = p[i] + q[i];
     b.e[i] = e_star[i] - P * k[i];
@@ -466,7 +467,7 @@ void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
     if (failed_now && p[i] <= 0 && q[i] <= 0) c2 = std::min(c2, c2_rest);
     const double c = std::sqrt(c2);
     const double trD = S.dvol[i] / dt;
-    const double Q = trD < 0 ? bulk_linear_ * c + bulk_quadratic_ * b.h * (-trD) : 0.0;
+    const double Q = trD < 0 ? bulk_linear_ * c + bulk_quadratic_ * h_step * (-trD) : 0.0;
     b.c[i] = widened(c, Q);
   }
   if (b.fault_index < 0)
