@@ -73,7 +73,7 @@ template <bool kPlastic, bool kMieGruneisen>
 void fused_block(const FusedModel& f, MaterialBlock& b, const double (*__restrict L)[kBlock],
                  Columns& X) {
   const int n = b.n;
-  const double dt = b.dt, hdt = 0.5 * dt, bh = b.h, bh_step = b.h_step > 0 ? b.h_step : b.h;
+  const double dt = b.dt, hdt = 0.5 * dt, bh = b.h, bh_step = b.step_length();
   const double G2 = 2.0 * f.G, G3 = 3.0 * f.G, G43 = 4.0 / 3.0 * f.G;
   const double A_y = f.A, B_y = f.B, H_ret = 3.0 * f.G + f.B;
   const double rho0 = f.rho0, K_lin = f.K, k0 = f.k0, sm1 = f.s - 1.0, g0 = f.gamma0;

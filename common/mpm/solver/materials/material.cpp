@@ -438,7 +438,7 @@ void Material::update_once(MaterialBlock& b, BlockScratch& S) const {
     }
   const double G43 = 4.0 / 3.0 * G_, c2_rest = K0_eos_ / spec_.density;
   const double yield_none = no_flow_stress(G_);
-  const double h_step = b.h_step > 0 ? b.h_step : b.h;
+  const double h_step = b.step_length();
   for (int i = 0; i < n; ++i) {
     const double rho = b.rho[i], P = p[i] + q[i];
     b.e[i] = e_star[i] - P * k[i];

@@ -40,9 +40,10 @@ struct MaterialBlock {
   double dt = 0;  ///< s
   double h = 0;   ///< cell size, m (length scale of the bulk viscosity)
   /// Length of the time step, m: the signal speed b.c is widened by the bulk viscosity's
-  /// quadratic term with this length, not h. On a graded grid the finest cell's, which the
-  /// step is taken over, while h is the particle's own cell's. 0: h (a lattice grid).
+  /// quadratic term with this length (step_length()), not h. On a graded grid the finest
+  /// cell's, which the step is taken over, while h is the particle's own cell's. 0: h.
   double h_step = 0;
+  double step_length() const { return h_step > 0 ? h_step : h; }
   const Mat3* L = nullptr;  ///< velocity gradient, 1/s; 3x3 also in 2D (zeros out of plane)
   /// Or the same one component an array (3D): L(r, c) of particle j at L_rows[3 r + c][j]; the
   /// fused update reads it in place, the others take it as L (Material::update).
