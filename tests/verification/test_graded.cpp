@@ -262,8 +262,8 @@ void viscosity_takes_the_cell() {
     if (dt > 0) solver.step(dt);
     return std::make_pair(std::move(cols), dt > 0 ? dt : solver.stable_dt());
   };
-  const double dt = 0.5 * run(1.5, 0).second;  // well inside the step with viscosity
   const double C0 = 1.5;
+  const double dt = 0.5 * run(C0, 0).second;  // well inside the step with viscosity
   const auto with = run(C0, dt).first;
   const auto without = run(0.0, dt).first;
   const ParticleView<D> a = view<D>(*with), b = view<D>(*without);

@@ -349,7 +349,7 @@ void ExplicitSolver<GridT>::stress_block(const ParticleView<D>& p, PendingBlock&
       s.momentum[a] += q;
     }
   }
-  s.dt_min = std::min(s.dt_min, grid_.min_cell_size() / fastest);  // the finest cell's step
+  s.dt_min = std::min(s.dt_min, blk.step_length() / fastest);  // the finest cell's step
   if (blk.fault_index >= 0 && s.fault < 0) {
     s.fault = pb.i0 + blk.fault_index;
     s.cause = blk.fault == PointFault::VolumeInverted
