@@ -225,3 +225,151 @@ TEST(Ogive, BadGeometryIsRefusedAtItsKey) {
   EXPECT_EQ(e.substr(0, 33), "scene.toml:10: bodies.rod.length:");
   EXPECT_NE(e.find("at least its nose's, 21.3922 mm for crh 3"), std::string::npos) << e;
 }
+
+// 2D scenes take the ogive's axial section: in plane strain a wedge-nosed plate, in axisymmetry
+// the section revolved about the axis (the projectile itself).
+
+TEST(Ogive, SectionAreaAndPerimeterMatchQuadrature) {
+  // Area: int 2 r(z) dz over the length. Perimeter: base, the shank's two sides and the two arcs,
+  // each arc's length from a fine polyline through the profile.
+  for (double crh : {0.5, 1.0, 3.0, 7.5}) {
+    const double R = 0.0127, nose = Ogive::nose_length(R, crh);
+    const Ogive o(R, nose + 0.05, crh);
+    // The substitution z = L_shank + L sin(t) takes out the arc's square-root end at the tip of a
+    // hemisphere (its slope is infinite there).
+    const double area = simpson([&](double z) { return 2 * o.radius_at(z); }, 0, o.L_shank, 2) +
+                        simpson(
+                            [&](double t) {
+                              const double z = o.L_shank + o.L_nose * std::sin(t);
+                              return 2 * o.radius_at(z) * o.L_nose * std::cos(t);
+                            },
+                            0, kPi / 2, 20000);
+    EXPECT_NEAR(o.section_area() / area, 1.0, 1e-10) << "crh " << crh;
+    // The arc from the profile's polyline through z = L_shank + L sin(t): the chords err by
+    // about the arc's length times (its angle / n)^2 / 24.
+    double arc = 0;
+    const int n = 100000;
+    for (int i = 0; i < n; ++i) {
+      const double z0 = o.L_shank + o.L_nose * std::sin(0.5 * kPi * i / n);
+      const double z1 = o.L_shank + o.L_nose * std::sin(0.5 * kPi * (i + 1) / n);
+      arc += std::hypot(z1 - z0, o.radius_at(z1) - o.radius_at(z0));
+    }
+    EXPECT_NEAR(o.section_perimeter(), 2 * R + 2 * o.L_shank + 2 * arc, 1e-9 * o.L_nose)
+        << "crh " << crh;
+  }
+  // A hemispherical nose on a zero-length shank is a half-disk.
+  const Ogive hemi(0.01, 0.01, 0.5);
+  EXPECT_NEAR(hemi.section_area(), 0.5 * kPi * 1e-4, 1e-16);
+  EXPECT_NEAR(hemi.section_perimeter(), 0.02 + kPi * 0.01, 1e-15);
+}
+
+TEST(Ogive, PlaneSectionVoxelisedInTwoDimensions) {
+  // V6's projectile's section, rotated 37 degrees and off the lattice, in plane strain: its area
+  // from the particles against the exact one, every particle inside, and the box tight.
+  const double h = 0.4e-3, s_p = h / 2;
+  Scene s = scene_around(h, Vec3(-0.06, -0.06, 0), Vec3(0.08, 0.08, 0));
+  s.dimension = 2;
+  BodySpec b = ogive_body(0.5 * 12.9e-3, 88.9e-3, 3.0);
+  b.rotate_deg = Vec3(0, 0, 37);
+  b.translate = Vec3(0.0131, -0.0217, 0);
+  s.bodies = {b};
+  const Ogive o(b.radius, b.length, b.crh);
+  const auto region = make_region(b, s);
+  EXPECT_NEAR(region->volume() / o.section_area(), 1.0, 1e-14);
+
+  const Lattice lattice = make_lattice(s);
+  std::vector<BodyReport> report;
+  const ColumnStore store = voxelise(s, lattice, report);
+  ASSERT_EQ(report.size(), 1u);
+  EXPECT_NEAR(report[0].exact_mass / (7850 * o.section_area()), 1.0, 1e-14);
+  // count x s^2 - A sums, over the points whose square straddles the boundary (within s / sqrt(2)
+  // of it: about N = sqrt(2) P / s of them), terms within +-1/2 of mean zero off the lattice: the
+  // error's standard deviation is at most s^2 sqrt(N) / 2; allow 4 of them (0.3% here).
+  const double n_shell = std::sqrt(2.0) * o.section_perimeter() / s_p;
+  const double tol = 4 * s_p * s_p * std::sqrt(n_shell) / 2;
+  const double a_count = store.size() * s_p * s_p;
+  EXPECT_NEAR(a_count, o.section_area(), tol) << "relative tolerance " << tol / o.section_area();
+  std::printf(
+      "ogive section: lattice %.6g mm^2, exact %.6g mm^2, error %.3g%% (tolerance %.3g%%)\n",
+      a_count * 1e6, o.section_area() * 1e6, 100 * (a_count / o.section_area() - 1),
+      100 * tol / o.section_area());
+  EXPECT_NEAR(report[0].mass / report[0].exact_mass, 1.0, tol / o.section_area());
+
+  const Mat3 R = rotation(b.rotate_deg);
+  const int dim = store.at("x").info().components;
+  const double* x = reinterpret_cast<const double*>(store.at("x").data());
+  Vec3 lo, hi, plo = Vec3::Constant(1e300), phi = -plo;
+  region->bounds(lo, hi);
+  double reach = -1e300;
+  for (std::size_t p = 0; p < store.size(); ++p) {
+    const Vec3 xp(x[dim * p], x[dim * p + 1], 0);
+    const Vec3 u = R.transpose() * (xp - b.translate);  // the section's local (x, y)
+    ASSERT_TRUE(o.contains(Vec3(u.x(), 0, u.y()))) << "particle " << p;
+    reach = std::max(reach, u.y());
+    plo = plo.cwiseMin(xp);
+    phi = phi.cwiseMax(xp);
+  }
+  EXPECT_LE(reach, b.length);
+  EXPECT_GE(reach, b.length - 3 * s_p / std::sin(std::atan(o.R / o.L_nose)));
+  for (int a = 0; a < 2; ++a) {
+    EXPECT_GE(plo[a], lo[a]);
+    EXPECT_LE(phi[a], hi[a]);
+    EXPECT_LT(plo[a] - lo[a], 2 * s_p) << a;
+    EXPECT_LT(hi[a] - phi[a], 2 * s_p) << a;
+  }
+}
+
+TEST(Ogive, AxisymmetricSectionIsTheProjectile) {
+  // Hanchak's projectile (V5) nose down on the axis: the exact mass per radian is rho V / (2 pi)
+  // and the particles' (rho s^2 x_p each) converge to it. The lattice tiles the shank exactly (R
+  // is 32 spacings and the base lies on a lattice line), so only the nose's points straddling the
+  // arc err: about N = sqrt(2) l / s of them (l the arc), each by at most s^2 R / 2 with mean
+  // zero; allow 4 standard deviations.
+  const double R = 12.7e-3, s_p = R / 32, h = 2 * s_p;
+  Scene s = scene_around(h, Vec3(0, -0.2, 0), Vec3(64 * h, 0.2, 0));
+  s.dimension = 2;
+  s.axisymmetric = true;
+  BodySpec b = ogive_body(R, 143.7e-3, 3.0);
+  b.rotate_deg = Vec3(0, 0, 180);
+  b.translate = Vec3(0, -0.2 + 400 * s_p, 0);  // the base on a lattice line
+  s.bodies = {b};
+  const Ogive o(b.radius, b.length, b.crh);
+  const Lattice lattice = make_lattice(s);
+  std::vector<BodyReport> report;
+  const ColumnStore store = voxelise(s, lattice, report);
+  ASSERT_EQ(report.size(), 1u);
+  const double exact = 7850 * o.volume() / (2 * kPi);
+  EXPECT_NEAR(report[0].exact_mass / exact, 1.0, 1e-14);
+  const double arc = o.rho * std::asin(o.L_nose / o.rho);
+  const double tol = 4 * s_p * s_p * R / 2 * std::sqrt(std::sqrt(2.0) * arc / s_p) * 7850 / exact;
+  EXPECT_NEAR(report[0].mass / exact, 1.0, tol);
+  std::printf(
+      "axisymmetric ogive: particles' mass %.6g g / rad, exact %.6g, error %.3g%% "
+      "(tolerance %.3g%%); whole %.6g g\n",
+      report[0].mass * 1e3, exact * 1e3, 100 * (report[0].mass / exact - 1), 100 * tol,
+      2 * kPi * exact * 1e3);
+  // Scaled by 2 radially and 1.5 along the axis: s_x^2 s_y times the volume.
+  b.scale = Vec3(2, 1.5, 1);
+  EXPECT_NEAR(make_region(b, s)->revolved_volume() / (6 * o.volume() / (2 * kPi)), 1.0, 1e-14);
+}
+
+TEST(Ogive, AxisymmetricOgiveOffTheAxisIsRefused) {
+  Scene s = scene_around(1e-3, Vec3(0, -0.2, 0), Vec3(0.1, 0.2, 0));
+  s.dimension = 2;
+  s.axisymmetric = true;
+  BodySpec b = ogive_body(6.45e-3, 88.9e-3, 3.0);
+  b.translate = Vec3(0.01, 0, 0);
+  std::string e = input_error(b, s);
+  EXPECT_EQ(e.substr(0, 37), "scene.toml:10: bodies.rod.translate: ") << e;
+  EXPECT_NE(e.find("on the axis, x = 0 (got x = 10 mm)"), std::string::npos) << e;
+  b.translate = Vec3(0, 0, 0);
+  b.rotate_deg = Vec3(0, 0, 90);
+  e = input_error(b, s);
+  EXPECT_EQ(e.substr(0, 34), "scene.toml:10: bodies.rod.rotate: ") << e;
+  b.rotate_deg = Vec3(0, 0, 180);
+  EXPECT_EQ(input_error(b, s), "(no InputError)");
+  s.axisymmetric = false;  // plane strain: anywhere, any angle
+  b.translate = Vec3(0.01, 0, 0);
+  b.rotate_deg = Vec3(0, 0, 90);
+  EXPECT_EQ(input_error(b, s), "(no InputError)");
+}

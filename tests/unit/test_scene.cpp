@@ -421,8 +421,8 @@ TEST(SceneErrors, FilesNameFileLineAndKey) {
       {"bad_vector_length.toml", 12,
        "bodies.bar.velocity: expected 3 components (x y z), got 2 in '0 -190 m/s'"},
       {"bad_2d_cylinder.toml", 12,
-       "bodies.bar.shape: shape \"cylinder\" is not available in 2D scenes; use box or sphere (a "
-       "disk)"},
+       "bodies.bar.shape: shape \"cylinder\" is not available in 2D scenes; use box, sphere (a "
+       "disk) or ogive (its axial section)"},
       {"bad_2d_z_face.toml", 22, "boundary.z_min: not available in 2D scenes"},
   };
   for (const auto& c : cases) {
@@ -529,12 +529,10 @@ TEST(SceneErrors, InlineCases) {
        "sphere)"},
       {"diameter on a cylinder", body_end, body_end + "\ndiameter = \"7.6 mm\"", "diameter",
        "bodies.bar.diameter: not used with shape = \"cylinder\" (this key is for ogive)"},
-      {"2D ogive", "shape = \"cylinder\"\nradius = \"3.8 mm\"\nlength = \"25.4 mm\"",
-       "shape = \"ogive\"\ndiameter = \"7.6 mm\"\nlength = \"25.4 mm\"\ncrh = 3", "shape",
-       "bodies.bar.shape: shape \"ogive\" is not available in 2D scenes; use box or sphere"},
       {"2D mesh", "shape = \"cylinder\"\nradius = \"3.8 mm\"\nlength = \"25.4 mm\"",
        "shape = \"mesh\"\nfile = \"a.stl\"", "shape",
-       "bodies.bar.shape: shape \"mesh\" is not available in 2D scenes; use box or sphere"},
+       "bodies.bar.shape: shape \"mesh\" is not available in 2D scenes; use box, sphere (a "
+       "disk) or ogive (its axial section)"},
       {"2D three-component velocity",
        "shape = \"cylinder\"\nradius = \"3.8 mm\"\nlength = \"25.4 mm\"",
        "shape = \"sphere\"\nradius = \"3.8 mm\"", "velocity",

@@ -682,7 +682,7 @@ TEST(Voxelise, TwoDimensionalRectangleAndDisk) {
   BodySpec tilted = sphere("t", 0.2, Vec3::Zero());
   tilted.rotate_deg = Vec3(10, 0, 0);
   d.bodies = {tilted};
-  EXPECT_NE(input_error_of([&] { run(d); }).find("bodies.t.rotate_deg"), std::string::npos);
+  EXPECT_NE(input_error_of([&] { run(d); }).find("bodies.t.rotate:"), std::string::npos);
 }
 
 // particle_spacing: a lattice of the body's own, independent of the cells (the seed's large V4

@@ -33,7 +33,7 @@ Mat3 placement(const BodySpec& b) {
 /// The extent of a primitive body's shape along each axis, m (lo, hi; an ogive's the box of its
 /// shank's cylinder); none for a mesh (its file
 /// is not in the stream).
-std::optional<std::pair<Vec3, Vec3>> shape_extent(const BodySpec& b) {
+std::optional<std::pair<Vec3, Vec3>> shape_extent(const BodySpec& b, int dim) {
   const Mat3 A = placement(b);
   const Vec3& t = b.translate;
   Vec3 lo, hi;
@@ -46,7 +46,13 @@ std::optional<std::pair<Vec3, Vec3>> shape_extent(const BodySpec& b) {
       case ShapeKind::Sphere:
         h = b.radius * A.row(a).norm();
         break;
-      case ShapeKind::Ogive:       // inside its shank's cylinder: that box (the nose never wider)
+      case ShapeKind::Ogive:  // inside its shank's cylinder: that box (the nose never wider)
+        if (dim == 2) {       // its section, along the local y from t to t + A (0, length)
+          c = t[a] + 0.5 * b.length * A(a, 1);
+          h = 0.5 * b.length * std::abs(A(a, 1)) + b.radius * std::abs(A(a, 0));
+          break;
+        }
+        [[fallthrough]];
       case ShapeKind::Cylinder: {  // from the base t to t + A (0, 0, length), radius r
         c = t[a] + 0.5 * b.length * A(a, 2);
         h = 0.5 * b.length * std::abs(A(a, 2)) + b.radius * std::hypot(A(a, 0), A(a, 1));
@@ -113,7 +119,7 @@ Symmetry scene_symmetry(const Scene& scene) {
       const double p = side ? scene.grid.domain_max[a] : scene.grid.domain_min[a];
       const double tol = 1e-6 * scene.grid.cell_size;
       for (const BodySpec& b : scene.bodies) {
-        const auto e = shape_extent(b);
+        const auto e = shape_extent(b, scene.dimension);
         if (!e || !(e->first[a] < p - tol && e->second[a] > p + tol)) continue;
         if (!s.planes.empty() && s.planes.back().axis == a) break;  // one plane per axis
         s.planes.push_back({a, p});

@@ -53,6 +53,20 @@ double Ogive::surface_area() const {
   return nose + 2 * pi * R * L_shank + pi * R * R;
 }
 
+double Ogive::section_area() const {
+  // Twice the half-section: int_0^L (sqrt(rho^2 - z^2) - a) dz = (L a + rho^2 asin(L / rho)) / 2
+  // - a L (sqrt(rho^2 - L^2) = a) for the nose, R L_shank for the shank. A hemisphere (a = 0,
+  // L = rho = R): pi R^2 / 4 a half, a half-disk whole.
+  const double L = L_nose;
+  const double half_nose = 0.5 * (rho * rho * std::asin(L / rho) - a * L);
+  return 2 * (half_nose + R * L_shank);
+}
+
+double Ogive::section_perimeter() const {
+  // Each arc subtends asin(L / rho) at its centre.
+  return 2 * R + 2 * L_shank + 2 * rho * std::asin(L_nose / rho);
+}
+
 double Ogive::support(const Vec3& w) const {
   // w . u = w_z z + q r on the profile (z, r), q = |(w_x, w_y)| >= 0 (the best azimuth). On
   // the shank it is linear in z: its ends. On the arc (z, r) = (L_shank, -a) + rho (sin t,

@@ -1,7 +1,8 @@
 #pragma once
 /// A projectile's shape: a cylindrical shank and a tangent-ogive nose, in its local frame (the
 /// axis is +z, the base at z = 0, the nose tip at z = length), with exact inside test, volume,
-/// surface area and support function. Private to prep (region.cpp places it like the other
+/// surface area and support function; in 2D scenes its axial section (region.cpp maps the
+/// local (x, y) of the plane to (x, 0, y)). Private to prep (region.cpp places it like the other
 /// primitives).
 #include "mpm/core/types.hpp"
 
@@ -22,6 +23,11 @@ struct Ogive {
   double volume() const;
   /// Exact area of the whole surface (m^2): base disk, shank's side and the nose.
   double surface_area() const;
+  /// Exact area of the axial section (m^2), the plane figure |x| <= radius_at(z): a 2D scene's
+  /// ogive (in plane strain a wedge-nosed plate, in axisymmetry this section revolved).
+  double section_area() const;
+  /// Exact perimeter of the axial section (m): base, the two shank sides and the two arcs.
+  double section_perimeter() const;
   /// Support function: the largest w . u over the points u of the ogive, for any w (not
   /// necessarily unit); the extent of a placed ogive along a world axis comes from it.
   double support(const Vec3& w) const;

@@ -101,13 +101,16 @@ class PrimitiveRegion final : public Region {
       }
       case ShapeKind::Ogive:
         // Along world axis a the ogive reaches t_a + h(A^T e_a) and t_a - h(-A^T e_a), h its
-        // support function in the local frame.
+        // support function in the local frame (in 2D the plane's local (x, y) is the ogive's
+        // (x, 0, y): its axis along the body's local y).
         for (int a = 0; a < 3; ++a) {
-          const Vec3 w = A.row(a).transpose();
+          Vec3 w = A.row(a).transpose();
+          if (dim == 2) w = Vec3(w.x(), 0, w.y());
           lo_[a] = t_[a] - ogive_.support(-w);
           hi_[a] = t_[a] + ogive_.support(w);
         }
-        volume_ = ogive_.volume() * ascale;
+        if (dim == 2) lo_.z() = hi_.z() = 0;
+        volume_ = (dim == 2 ? ogive_.section_area() : ogive_.volume()) * ascale;
         break;
       case ShapeKind::Mesh:
         break;  // not a primitive
@@ -125,7 +128,7 @@ class PrimitiveRegion final : public Region {
       case ShapeKind::Cylinder:
         return p.z() >= 0 && p.z() <= length_ && p.x() * p.x() + p.y() * p.y() <= r2_;
       case ShapeKind::Ogive:
-        return ogive_.contains(p);
+        return ogive_.contains(dim_ == 2 ? Vec3(p.x(), 0, p.y()) : p);
       case ShapeKind::Mesh:
         return false;
     }
@@ -139,6 +142,11 @@ class PrimitiveRegion final : public Region {
 
   double revolved_volume() const override {
     if (dim_ != 2) return Region::revolved_volume();
+    if (kind_ == ShapeKind::Ogive) {
+      // On the axis (check_body_shape): the solid of revolution of the section, scaled by s_x
+      // radially and s_y along the axis: s_x^2 s_y V / (2 pi) per radian.
+      return A_(0, 0) * A_(0, 0) * std::abs(A_(1, 1)) * ogive_.volume() / (2 * std::numbers::pi);
+    }
     if (kind_ == ShapeKind::Sphere) {
       // The ellipse {A u + t : |u| <= R}: x = a.u + t_x with a the first row of A. With w the
       // coordinate of u along a, the integral of x over x >= 0 is |det A| times the integral
@@ -192,21 +200,23 @@ class PrimitiveRegion final : public Region {
 /// Checks a body's shape parameters and placement; throws InputError at the offending key.
 void check_body_shape(const BodySpec& body, const Scene& scene) {
   const int dim = scene.dimension;
-  if (dim == 2 && body.shape != ShapeKind::Box && body.shape != ShapeKind::Sphere)
+  if (dim == 2 && body.shape != ShapeKind::Box && body.shape != ShapeKind::Sphere &&
+      body.shape != ShapeKind::Ogive)
     throw InputError(body_where(scene, body, "shape"),
                      "body '" + body.name + "' has shape " + shape_name(body.shape) +
-                         "; a 2D scene takes only box (a rectangle) and sphere (a disk)");
+                         "; a 2D scene takes only box (a rectangle), sphere (a disk) and ogive "
+                         "(its axial section)");
   for (int a = 0; a < dim; ++a)
     if (!(body.scale[a] != 0) || !std::isfinite(body.scale[a]))
       throw InputError(body_where(scene, body, "scale"),
                        std::string("the scale along ") + axis_name(a) +
                            " must be a non-zero number (got " + format_g6(body.scale[a]) + ")");
   if (!finite(body.rotate_deg))
-    throw InputError(body_where(scene, body, "rotate_deg"), "the rotation must be finite");
+    throw InputError(body_where(scene, body, "rotate"), "the rotation must be finite");
   if (!finite(body.translate))
     throw InputError(body_where(scene, body, "translate"), "the translation must be finite");
   if (dim == 2 && (body.rotate_deg.x() != 0 || body.rotate_deg.y() != 0))
-    throw InputError(body_where(scene, body, "rotate_deg"),
+    throw InputError(body_where(scene, body, "rotate"),
                      "a 2D scene rotates bodies only about z; the x and y angles must be 0");
   switch (body.shape) {
     case ShapeKind::Box:
@@ -246,6 +256,23 @@ void check_body_shape(const BodySpec& body, const Scene& scene) {
                              format_g6(nose * 1e3) + " mm for crh " + format_g6(body.crh) +
                              " and diameter " + format_g6(2e3 * body.radius) + " mm (got " +
                              format_g6(body.length * 1e3) + " mm)");
+      if (dim == 2 && scene.axisymmetric) {
+        // Revolved about the scene's axis the section must give the projectile, not a ring: its
+        // axis on x = 0, pointing along +y or -y.
+        const Mat3 A = body_linear_map(body);
+        const double tol = 1e-9 * body.length;
+        if (!(std::abs(body.translate.x()) <= tol))
+          throw InputError(body_where(scene, body, "translate"),
+                           "in an axisymmetric scene an ogive's base centre must lie on the axis, "
+                           "x = 0 (got x = " +
+                               format_g6(body.translate.x() * 1e3) + " mm)");
+        if (!(std::abs(A(0, 1)) <= 1e-12 * std::abs(A(1, 1)) &&
+              std::abs(A(1, 0)) <= 1e-12 * std::abs(A(0, 0))))
+          throw InputError(body_where(scene, body, "rotate"),
+                           "in an axisymmetric scene an ogive points along the axis: rotate = 0 "
+                           "(nose towards +y) or 180 (towards -y), got " +
+                               format_g6(body.rotate_deg.z()) + " deg");
+      }
       break;
     }
     case ShapeKind::Mesh:

@@ -81,9 +81,11 @@ void read_shape(Reader& r, const Scene& scene, BodySpec& b) {
                                                    {"mesh", ShapeKind::Mesh}});
   if (!shape) r.missing("shape", "one of \"box\", \"cylinder\", \"sphere\", \"ogive\", \"mesh\"");
   b.shape = *shape;
-  if (two_d && b.shape != ShapeKind::Box && b.shape != ShapeKind::Sphere) {
+  if (two_d && b.shape != ShapeKind::Box && b.shape != ShapeKind::Sphere &&
+      b.shape != ShapeKind::Ogive) {
     r.fail("shape", "shape \"" + *r.string("shape") +
-                        "\" is not available in 2D scenes; use box or sphere (a disk)");
+                        "\" is not available in 2D scenes; use box, sphere (a disk) or ogive "
+                        "(its axial section)");
   }
   const std::string shape_name = *r.string("shape");
   const auto not_for = [&](std::string_view applies) {
