@@ -298,5 +298,32 @@ TEST(HjcCli, BadHjcInputExitsTwo) {
   EXPECT_NE(r.err.find("materials.concrete.strength.fc: must be > 0"), std::string::npos) << r.err;
 }
 
+// examples/rc-slab/axisym.toml is V5's projectile and slab in axisymmetry: the ogive on the axis
+// (25 mm across, so that the particles' lattices tile its shank) with the density that keeps the
+// 3D scene's exact projectile mass, 0.514 kg whole, and the particles' mass within 0.2% of it.
+TEST(HjcCli, AxisymmetricV5KeepsTheQuarterModelsProjectileMass) {
+  const auto dir = temp_dir("hjc_axisym_v5");
+  const std::string ex = std::string(MPM_EXAMPLES) + "/rc-slab/";
+  // The "projectile" row of mpm-prep's mass table: particles' mass and exact mass, kg.
+  const auto masses = [&](const std::string& args) {
+    const Result r = run(prep + " " + args + " -o /dev/null", dir);
+    EXPECT_EQ(r.status, 0) << r.err;
+    const auto at = r.err.find("\n  projectile ");
+    EXPECT_NE(at, std::string::npos) << r.err;
+    std::pair<double, double> m{0, 0};
+    const auto kg = r.err.find(" mm ", at);  // after the spacing
+    if (at != std::string::npos && kg != std::string::npos)
+      std::sscanf(r.err.c_str() + kg + 4, "%lf %lf", &m.first, &m.second);
+    return m;
+  };
+  const auto whole = masses(ex + "scene.toml --set grid.cell_size=16mm");
+  EXPECT_NEAR(whole.second, 0.514443, 1e-6);
+  for (const char* path : {"", " --set bodies.projectile.particles_per_cell=2"}) {
+    const auto axi = masses(ex + "axisym.toml" + path);  // per radian
+    EXPECT_NEAR(2 * M_PI * axi.second / whole.second, 1.0, 1e-5) << path;
+    EXPECT_NEAR(axi.first / axi.second, 1.0, 2e-3) << path;
+  }
+}
+
 }  // namespace
 }  // namespace mpm
