@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "mpm/core/error.hpp"
 #include "mpm/grid/lattice.hpp"
@@ -71,6 +73,21 @@ Mat3 rotation(const Vec3& deg) {
           Eigen::AngleAxisd(k * deg.y(), Vec3::UnitY()) *
           Eigen::AngleAxisd(k * deg.x(), Vec3::UnitX()))
       .toRotationMatrix();
+}
+
+/// A body placed in a scene and filled with particles: its region, the particles and the report.
+struct Filled {
+  std::unique_ptr<Region> region;
+  ColumnStore store;
+  std::vector<BodyReport> report;
+};
+
+Filled fill(Scene s, const BodySpec& b) {
+  s.bodies = {b};
+  Filled f;
+  f.region = make_region(b, s);
+  f.store = voxelise(s, make_lattice(s), f.report);
+  return f;
 }
 
 std::string input_error(const BodySpec& b, const Scene& s) {
@@ -158,14 +175,9 @@ TEST(Ogive, PlacedAndVoxelisedLikeThePrimitives) {
   BodySpec b = ogive_body(0.5 * 12.9e-3, 88.9e-3, 3.0);
   b.rotate_deg = Vec3(12, 63, -21);
   b.translate = Vec3(-0.031, 0.0017, -0.0123);
-  s.bodies = {b};
   const Ogive o(b.radius, b.length, b.crh);
-  const auto region = make_region(b, s);
+  const auto [region, store, report] = fill(s, b);
   EXPECT_NEAR(region->volume() / o.volume(), 1.0, 1e-14);
-
-  const Lattice lattice = make_lattice(s);
-  std::vector<BodyReport> report;
-  const ColumnStore store = voxelise(s, lattice, report);
   ASSERT_EQ(report.size(), 1u);
   EXPECT_NEAR(report[0].exact_mass, 7850 * o.volume(), 1e-9);
 
@@ -272,14 +284,9 @@ TEST(Ogive, PlaneSectionVoxelisedInTwoDimensions) {
   BodySpec b = ogive_body(0.5 * 12.9e-3, 88.9e-3, 3.0);
   b.rotate_deg = Vec3(0, 0, 37);
   b.translate = Vec3(0.0131, -0.0217, 0);
-  s.bodies = {b};
   const Ogive o(b.radius, b.length, b.crh);
-  const auto region = make_region(b, s);
+  const auto [region, store, report] = fill(s, b);
   EXPECT_NEAR(region->volume() / o.section_area(), 1.0, 1e-14);
-
-  const Lattice lattice = make_lattice(s);
-  std::vector<BodyReport> report;
-  const ColumnStore store = voxelise(s, lattice, report);
   ASSERT_EQ(report.size(), 1u);
   EXPECT_NEAR(report[0].exact_mass / (7850 * o.section_area()), 1.0, 1e-14);
   // count x s^2 - A sums, over the points whose square straddles the boundary (within s / sqrt(2)
@@ -332,11 +339,8 @@ TEST(Ogive, AxisymmetricSectionIsTheProjectile) {
   BodySpec b = ogive_body(R, 143.7e-3, 3.0);
   b.rotate_deg = Vec3(0, 0, 180);
   b.translate = Vec3(0, -0.2 + 400 * s_p, 0);  // the base on a lattice line
-  s.bodies = {b};
   const Ogive o(b.radius, b.length, b.crh);
-  const Lattice lattice = make_lattice(s);
-  std::vector<BodyReport> report;
-  const ColumnStore store = voxelise(s, lattice, report);
+  const auto report = fill(s, b).report;
   ASSERT_EQ(report.size(), 1u);
   const double exact = 7850 * o.volume() / (2 * kPi);
   EXPECT_NEAR(report[0].exact_mass / exact, 1.0, 1e-14);
