@@ -30,7 +30,7 @@ for p in $paths; do
   [ "$p" = 4 ] && ppc=8
   for s in $shifts; do
     name=ax${p}_${s}_$speed
-    y=$(awk -v s="$s" 'BEGIN { printf "%g", 144.2 + s }')
+    y=$(awk -v s="$s" 'BEGIN { printf "%g", 144.2 + s }')  # axisym.toml's start, 144.2 mm
     echo "running $name ($(date +%H:%M:%S)) ..." >&2
     "$bin/mpm-prep/mpm-prep" axisym.toml --set "grid.levels=$(levels "$p")" \
       --set bodies.projectile.particles_per_cell=$ppc --set "bodies.projectile.translate=0 $y mm" \
