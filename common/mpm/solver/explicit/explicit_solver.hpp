@@ -105,6 +105,7 @@ class ExplicitSolver : public SolverCore<GridT> {
   void update_stress(const std::vector<Vec<D>>& v_grad, Positions positions);
   void average_damage();  ///< HJC with damage_length: the step's increments averaged, added
   void exchange_momentum(Exchange on);
+  void mirror_slip_normals();  ///< contact normals on the slip faces (contact.hpp, "Symmetry")
   void split_particles() requires GridT::kGraded;
   void rebar_forces();
 

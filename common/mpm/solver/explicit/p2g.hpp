@@ -275,11 +275,13 @@ void ExplicitSolver<GridT>::add_to_field(const ParticleView<D>& p, std::uint32_t
   const Vec<D> mv_p = m_p * p.v[i];
   const bool volume = kM && !fd.V.empty();
   const double V_p = volume ? m_p / p.rho[i] : 0.0;
+  // The section's mass in axisymmetry (contact.hpp, "Symmetry"): the normal of the r-z section.
+  const double m_g = kM && axisymmetric_ ? m_p / p.x[i][0] : m_p;
   for (int c = 0; c < nk; ++c) {
     const std::int64_t n = nd[c];
     if constexpr (kM) {
       fd.m[n] += m_p * N[c];
-      fd.g[n] += m_p * G[c];              // the body's mass gradient: the contact normal
+      fd.g[n] += m_g * G[c];              // the body's mass gradient: the contact normal
       fd.x[n] += (m_p * N[c]) * p.x[i];   // its centre: the gap
       if (volume) fd.V[n] += V_p * N[c];  // its share of the node: where its surface is
     }
