@@ -56,31 +56,28 @@ History run(const std::string& toml, const std::string& name) {
   return h;
 }
 
-// A steel punch 2 mm wide at 100 m/s onto a block 4 mm wide (nu 0.3: both bulge sideways; the
-// punch's corners press on the block's face), to 6 us. `half`: x >= 0 only, the plane x = 0 a
-// slip face.
-std::string punch(bool half) {
-  const std::string x0 = half ? "0" : "-3";
-  return std::string(R"(
-[scene]
-dimension = 2
+/// A 2D scene's steel (nu 0.3) and a steel box of it: `size` and `at` as the scene writes them.
+const char* kSteel = R"(
 [materials.steel]
 density = "7800 kg/m^3"
 youngs_modulus = "200 GPa"
 poisson_ratio = 0.3
-[[bodies]]
-name = "punch"
-material = "steel"
-shape = "box"
-size = "2 3 mm"
-translate = "0 1.75 mm"
-velocity = "0 -100 m/s"
-[[bodies]]
-name = "block"
-material = "steel"
-shape = "box"
-size = "4 3 mm"
-translate = "0 -1.5 mm"
+)";
+
+std::string box(const std::string& name, const std::string& size, const std::string& at,
+                const std::string& velocity) {
+  return "[[bodies]]\nname = \"" + name + "\"\nmaterial = \"steel\"\nshape = \"box\"\nsize = \"" +
+         size + "\"\ntranslate = \"" + at + "\"\nvelocity = \"" + velocity + "\"\n";
+}
+
+// A steel punch 2 mm wide at 100 m/s onto a block 4 mm wide (nu 0.3: both bulge sideways; the
+// punch's corners press on the block's face), to 6 us. `half`: x >= 0 only, the plane x = 0 a
+// slip face.
+std::string punch(bool half) {
+  return std::string("[scene]\ndimension = 2\n") + kSteel +
+         box("punch", "2 3 mm", "0 1.75 mm", "0 -100 m/s") +
+         box("block", "4 3 mm", "0 -1.5 mm", "0 0 m/s") +
+         R"(
 [[contact]]
 bodies = ["punch", "block"]
 friction = 0
@@ -88,8 +85,8 @@ normal = "punch"
 separation = 0.125
 [grid]
 cell_size = "0.25 mm"
-domain = { min = ")") +
-         x0 + R"( -4 mm", max = "3 4 mm" }
+domain = { min = ")" +
+         (half ? "0" : "-3") + R"( -4 mm", max = "3 4 mm" }
 [boundary]
 x_min = ")" +
          (half ? "slip" : "free") + R"("
@@ -128,29 +125,9 @@ TEST(ContactSymmetry, HalfModelOnASlipFaceIsTheWholeModelsHalf) {
 // the plane-strain run; the section's normal is axial at every node of the faces, so the
 // contact pushes no particle sideways.
 std::string sleeve(bool axisymmetric) {
-  return std::string(R"(
-[scene]
-dimension = 2
-geometry = ")") +
-         (axisymmetric ? "axisymmetric" : "plane-strain") + R"("
-[materials.steel]
-density = "7800 kg/m^3"
-youngs_modulus = "200 GPa"
-poisson_ratio = 0.3
-[[bodies]]
-name = "a"
-material = "steel"
-shape = "box"
-size = "2 4 mm"
-translate = "1 2 mm"
-velocity = "0 -50 m/s"
-[[bodies]]
-name = "b"
-material = "steel"
-shape = "box"
-size = "2 4 mm"
-translate = "1 -2 mm"
-velocity = "0 50 m/s"
+  return std::string("[scene]\ndimension = 2\ngeometry = \"") +
+         (axisymmetric ? "axisymmetric" : "plane-strain") + "\"\n" + kSteel +
+         box("a", "2 4 mm", "1 2 mm", "0 -50 m/s") + box("b", "2 4 mm", "1 -2 mm", "0 50 m/s") + R"(
 [[contact]]
 bodies = ["a", "b"]
 friction = 0
