@@ -50,7 +50,7 @@
 // section's, sum_p (m_p / r_p) grad N_i: a particle's mass per radian grows with its radius,
 // and inside a uniform body that gradient, -rho A_i e_r, tilts the normal toward the axis by
 // about the cell over the node's radius (two bars meeting flat in a sleeve at 50 m/s threw
-// particles sideways at 53 m/s; now at 1e-12 m/s).
+// particles sideways at 47 m/s with the slip faces mirrored, 53 m/s without; now at 1e-12 m/s).
 #include <omp.h>
 
 #include <algorithm>
