@@ -11,7 +11,11 @@
 # rate (`make tension`): the concrete's tensile strength rises with the strain rate
 # (materials.concrete.strength.tension_rate = "malvar-ross", docs/scene.md): cases
 # c<cell>_<v>_rate, and table.md gives each speed's change from HJC as published.
-# Usage: ./study.sh BUILD_DIR THREADS "434 606 749 1058" CELL "16mm 10mm 8mm" [node|mid|rate]
+# friction (`make friction`): Coulomb friction FRICTION (default 0.1) between projectile and
+# slab instead of none: cases c<cell>_<v>_friction; rate-friction both changes at once: cases
+# c<cell>_<v>_rate-friction. table.md gives each speed's change from the scene as it is.
+# Usage: ./study.sh BUILD_DIR THREADS "434 606 749 1058" CELL "16mm 10mm 8mm"
+#          [node|mid|rate|friction|rate-friction]
 set -euo pipefail
 cd "$(dirname "$0")"
 bin=$1 threads=$2 speeds=$3 cell=$4 cells=$5 place=${6:-node}
@@ -20,7 +24,14 @@ case $place in
   node) suffix= ;;
   mid) suffix=_mid ;;
   rate) suffix=_rate extra=(--set materials.concrete.strength.tension_rate=malvar-ross) ;;
-  *) echo "study.sh: the variant is node, mid or rate, not '$place'" >&2; exit 2 ;;
+  friction) suffix=_friction extra=(--set "contact.0.friction=${FRICTION:-0.1}") ;;
+  rate-friction)
+    suffix=_rate-friction
+    extra=(--set materials.concrete.strength.tension_rate=malvar-ross
+      --set "contact.0.friction=${FRICTION:-0.1}") ;;
+  *)
+    echo "study.sh: the variant is node, mid, rate, friction or rate-friction, not '$place'" >&2
+    exit 2 ;;
 esac
 mkdir -p study
 # 004 Table 5's end times.

@@ -24,6 +24,11 @@ VARIANTS = [
     ("rate", "Rate-dependent tension (`make tension`): HJC's T times Malvar and Ross's factor at "
      "the largest principal strain rate (tension_rate = \"malvar-ross\") against HJC as "
      "published, same cells:", "T rate-dependent"),
+    ("friction", "Friction (`make friction`): Coulomb friction (FRICTION, 0.1 unless set) between "
+     "projectile and slab against none, same cells:", "friction"),
+    ("rate-friction", "Both (`make friction-tension`): the rate-dependent tension and the "
+     "friction at once against HJC as published without friction, same cells:",
+     "both"),
 ]
 
 
@@ -147,7 +152,8 @@ def main():
     for suffix, title, column in VARIANTS:
         found = []
         for path in sorted(glob.glob(os.path.join(study, f"residual_c*_*_{suffix}.json"))):
-            m = re.match(rf"residual_c([0-9.]+)_(\d+)_{suffix}\.json$", os.path.basename(path))
+            m = re.match(rf"residual_c([0-9.]+)_(\d+)_{re.escape(suffix)}\.json$",
+                         os.path.basename(path))
             if not m:
                 continue
             cell, v = m.group(1), int(m.group(2))
